@@ -1,0 +1,19 @@
+#include "core/errors.h"
+
+namespace curvesfm {
+
+IoError::IoError(const std::string& path, const std::string& problem)
+    : Error("IoError: " + path + ": " + problem) {}
+
+ParseError::ParseError(const std::string& path, int line, const std::string& expected,
+                       const std::string& found)
+    : Error("ParseError: " + path + (line > 0 ? ":" + std::to_string(line) : std::string()) +
+            ": expected " + expected + ", found " + found),
+      path_(path),
+      line_(line) {}
+
+InvalidOptions::InvalidOptions(const std::string& struct_name, const std::string& field,
+                               const std::string& value, const std::string& constraint)
+    : Error("InvalidOptions: " + struct_name + "." + field + " = " + value + ": " + constraint) {}
+
+}  // namespace curvesfm

@@ -36,7 +36,7 @@ class Direction {
   /// Angle to `other` in radians, in [0, pi].
   double angleTo(const Direction& other) const;
 
-  void toAmbient(double* out) const { Eigen::Map<Eigen::Vector3d>(out) = v_; }
+  void toAmbient(double* out) const { Eigen::Vector3d::Map(out) = v_; }
   static Direction fromAmbient(const double* in) {
     return Direction(Eigen::Vector3d(in[0], in[1], in[2]));
   }

@@ -85,8 +85,8 @@ Vector6d Pose3::localCoordinates(const Pose3& other, Matrix6d* H_this, Matrix6d*
 }
 
 void Pose3::toAmbient(double* out) const {
-  Eigen::Map<Eigen::Vector4d>(out) = rotation_.coeffs();
-  Eigen::Map<Eigen::Vector3d>(out + 4) = translation_;
+  Eigen::Vector4d::Map(out) = rotation_.coeffs();
+  Eigen::Vector3d::Map(out + 4) = translation_;
 }
 
 Pose3 Pose3::fromAmbient(const double* in) {

@@ -1,5 +1,6 @@
 #include "core/direction.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "core/check.h"

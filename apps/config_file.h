@@ -1,0 +1,25 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace curvesfm {
+
+/// Reads a YAML config file for `command` and turns it into command-line arguments, so that
+/// every flag can be set from the file: each top-level key is a long flag name without dashes
+/// (`max-iterations: 20`, `kernel: cauchy`, `verbose: true`), a sequence gives several values.
+/// Put the returned arguments before the user's own so that flags override the file.
+/// Throws IoError (unreadable file) or ParseError naming path:line (malformed YAML, a key that
+/// is not a flag of `command`, a nested mapping).
+std::vector<std::string> configFileArguments(const std::string& path, const CLI::App& command);
+
+/// Every option of `command` with a long name (except help and config) and its effective value:
+/// as given on the command line or in the config file, else its default; in declaration order.
+std::vector<std::pair<std::string, std::string>> effectiveOptions(const CLI::App& command);
+
+/// effectiveOptions() as YAML that configFileArguments() reads back.
+std::string effectiveOptionsYaml(const CLI::App& command);
+
+}  // namespace curvesfm

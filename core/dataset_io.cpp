@@ -1,0 +1,326 @@
+#include "core/dataset_io.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iterator>
+#include <limits>
+#include <locale>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <regex>
+#include <sstream>
+#include <string_view>
+#include <system_error>
+
+#include "core/check.h"
+#include "core/errors.h"
+
+namespace curvesfm {
+namespace {
+
+using Fields = std::vector<std::string_view>;
+
+constexpr char kImageListFormat[] = "timestamp path";
+constexpr char kTrajectoryFormat[] = "timestamp tx ty tz qx qy qz qw";
+constexpr const char* kTrajectoryFieldNames[] = {"timestamp", "tx", "ty", "tz",
+                                                 "qx",        "qy", "qz", "qw"};
+constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
+// Longest token quoted verbatim in a message; binary junk must not flood the terminal.
+constexpr std::size_t kMaxQuotedToken = 40;
+
+std::string toString(double value) {
+  std::ostringstream out;
+  out.imbue(std::locale::classic());
+  out << std::setprecision(std::numeric_limits<double>::digits10) << value;
+  return out.str();
+}
+
+std::string quoteToken(std::string_view token) {
+  if (token.size() > kMaxQuotedToken) {
+    return "\"" + std::string(token.substr(0, kMaxQuotedToken)) + "...\"";
+  }
+  return "\"" + std::string(token) + "\"";
+}
+
+std::ifstream openForReading(const std::string& path) {
+  // An ifstream opens a directory without complaint on Linux and only fails on the first read,
+  // which would look like an empty file.
+  std::error_code ignored;
+  if (std::filesystem::is_directory(path, ignored)) {
+    throw IoError(path, "cannot open for reading (it is a directory)");
+  }
+  std::ifstream in(path);
+  if (!in) throw IoError(path, "cannot open for reading");
+  return in;
+}
+
+Fields splitFields(std::string_view line) {
+  // '\r' counts as a blank so that CRLF files parse like LF files.
+  constexpr std::string_view kBlanks = " \t\r\v\f";
+  Fields fields;
+  std::size_t begin = line.find_first_not_of(kBlanks);
+  while (begin != std::string_view::npos) {
+    const std::size_t end = std::min(line.find_first_of(kBlanks, begin), line.size());
+    fields.push_back(line.substr(begin, end - begin));
+    begin = line.find_first_not_of(kBlanks, end);
+  }
+  return fields;
+}
+
+// Calls visit(line_number, fields) for every line that is neither blank nor a comment.
+template <class Visit>
+void forEachRecord(const std::string& path, Visit&& visit) {
+  std::ifstream in = openForReading(path);
+  std::string line;
+  int line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    std::string_view view(line);
+    if (line_number == 1 && view.substr(0, kUtf8Bom.size()) == kUtf8Bom) {
+      view.remove_prefix(kUtf8Bom.size());
+    }
+    const Fields fields = splitFields(view);
+    if (fields.empty() || fields.front().front() == '#') continue;
+    visit(line_number, fields);
+  }
+  if (in.bad()) throw IoError(path, "read error");
+}
+
+// std::from_chars is locale independent, unlike strtod, whose decimal separator follows the
+// global C locale.
+std::optional<double> parseFiniteNumber(std::string_view token) {
+  // from_chars rejects the leading '+' that strtod and printf("%+f") produce.
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') {
+    token.remove_prefix(1);
+  }
+  double value = 0.0;
+  const char* end = token.data() + token.size();
+  const auto [stop, error] = std::from_chars(token.data(), end, value);
+  if (error != std::errc() || stop != end || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+void requireFieldCount(const std::string& path, int line, const Fields& fields, std::size_t count,
+                       const char* format) {
+  if (fields.size() != count) {
+    throw ParseError(path, line, std::to_string(count) + " fields \"" + format + "\"",
+                     std::to_string(fields.size()));
+  }
+}
+
+double numberField(const std::string& path, int line, const Fields& fields, std::size_t index,
+                   const char* name) {
+  if (const std::optional<double> value = parseFiniteNumber(fields[index])) return *value;
+  throw ParseError(path, line, "a number in field " + std::to_string(index + 1) + " (" + name + ")",
+                   quoteToken(fields[index]));
+}
+
+std::string readWholeFile(const std::string& path) {
+  std::ifstream in = openForReading(path);
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) throw IoError(path, "read error");
+  if (text.compare(0, kUtf8Bom.size(), kUtf8Bom) == 0) text.erase(0, kUtf8Bom.size());
+  return text;
+}
+
+// OpenCV recognises YAML only by a "%YAML" directive in the very first bytes (even a comment
+// before it fails), yet hand-written camera files often omit it. So OpenCV always parses our own
+// directive, and the file's directive, if any, is blanked in place: every line number OpenCV
+// reports is then exactly one more than the file's.
+constexpr char kOpenCvYamlDirective[] = "%YAML:1.0\n";
+constexpr int kDirectiveLines = 1;
+
+std::string withOwnYamlDirective(std::string text) {
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    const std::size_t end = std::min(text.find('\n', begin), text.size());
+    const std::string_view line(text.data() + begin, end - begin);
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first != std::string_view::npos && line[first] != '#') {
+      if (line.substr(first, 5) == "%YAML") text.erase(begin, end - begin);
+      break;
+    }
+    begin = end + 1;
+  }
+  return kOpenCvYamlDirective + text;
+}
+
+// OpenCV's parser errors carry "<file>(<line>): <message>" in cv::Exception::func.
+[[noreturn]] void throwYamlError(const std::string& path, const cv::Exception& e) {
+  static const std::regex kLocated(R"(\((\d+)\): (.*)$)");
+  std::smatch match;
+  if (std::regex_search(e.func, match, kLocated)) {
+    const int line = std::max(0, std::stoi(match[1].str()) - kDirectiveLines);
+    throw ParseError(path, line, "OpenCV FileStorage YAML",
+                     "\"" + match[2].str() + "\" (OpenCV YAML parser)");
+  }
+  throw ParseError(path, 0, "OpenCV FileStorage YAML", "\"" + std::string(e.what()) + "\"");
+}
+
+void openYaml(const std::string& path, const std::string& text, cv::FileStorage* storage) {
+  try {
+    const int flags =
+        cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML;
+    if (storage->open(withOwnYamlDirective(text), flags)) return;
+  } catch (const cv::Exception& e) {
+    throwYamlError(path, e);
+  }
+  throw ParseError(path, 0, "OpenCV FileStorage YAML", "content OpenCV cannot open");
+}
+
+// 1-based line of a top-level "key:" in `text`, 0 if not found; OpenCV's nodes do not keep it.
+int lineOfKey(const std::string& text, const std::string& key) {
+  std::istringstream in(text);
+  std::string line;
+  for (int line_number = 1; std::getline(in, line); ++line_number) {
+    const std::size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line.compare(first, key.size(), key) != 0) continue;
+    const std::size_t colon = line.find_first_not_of(" \t", first + key.size());
+    if (colon != std::string::npos && line[colon] == ':') return line_number;
+  }
+  return 0;
+}
+
+std::string describeNode(const cv::FileNode& node) {
+  if (node.isString()) return quoteToken(node.string());
+  if (node.isSeq()) return "a sequence";
+  if (node.isMap()) return "a mapping";
+  return "a value of OpenCV node type " + std::to_string(node.type());
+}
+
+// The camera file's text and parsed tree, so that errors can name the key's line.
+struct YamlFile {
+  const std::string& path;
+  const std::string& text;
+  const cv::FileStorage& storage;
+
+  // The key's finite number, or `fallback` if the key is absent and fallback is given.
+  double number(const std::string& key, std::optional<double> fallback = std::nullopt) const {
+    const cv::FileNode node = storage[key];
+    if (node.isNone()) {
+      if (fallback) return *fallback;
+      throw ParseError(path, 0, "key " + key + " (a number)", "no such key");
+    }
+    const int line = lineOfKey(text, key);
+    if (!node.isInt() && !node.isReal()) {
+      throw ParseError(path, line, "key " + key + " (a number)", describeNode(node));
+    }
+    const double value = node.real();
+    if (!std::isfinite(value)) {
+      throw ParseError(path, line, "key " + key + " (a finite number)", toString(value));
+    }
+    return value;
+  }
+
+  double positiveNumber(const std::string& key) const {
+    const double value = number(key);
+    if (value <= 0.0) {
+      throw ParseError(path, lineOfKey(text, key), "key " + key + " > 0", toString(value));
+    }
+    return value;
+  }
+
+  int pixelCount(const std::string& key) const {
+    const double value = number(key);
+    if (value < 1.0 || value > std::numeric_limits<int>::max() || value != std::floor(value)) {
+      throw ParseError(path, lineOfKey(text, key),
+                       "key " + key + " (a positive whole number of pixels)", toString(value));
+    }
+    return static_cast<int>(value);
+  }
+};
+
+}  // namespace
+
+std::vector<ImageEntry> readImageList(const std::string& rgb_txt_path) {
+  const std::filesystem::path folder = std::filesystem::path(rgb_txt_path).parent_path();
+  std::vector<ImageEntry> entries;
+  forEachRecord(rgb_txt_path, [&](int line, const Fields& fields) {
+    requireFieldCount(rgb_txt_path, line, fields, 2, kImageListFormat);
+    const double timestamp = numberField(rgb_txt_path, line, fields, 0, "timestamp");
+    // operator/ keeps an absolute right-hand side as it is.
+    entries.push_back({timestamp, (folder / std::string(fields[1])).string()});
+  });
+  if (entries.empty()) {
+    throw ParseError(rgb_txt_path, 0,
+                     std::string("at least one image line \"") + kImageListFormat + "\"", "none");
+  }
+  return entries;
+}
+
+std::vector<StampedPose> readTrajectory(const std::string& path) {
+  std::vector<StampedPose> poses;
+  forEachRecord(path, [&](int line, const Fields& fields) {
+    requireFieldCount(path, line, fields, 8, kTrajectoryFormat);
+    double v[8];
+    for (std::size_t i = 0; i < 8; ++i) {
+      v[i] = numberField(path, line, fields, i, kTrajectoryFieldNames[i]);
+    }
+    const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    const double norm = q.norm();
+    if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) {
+      throw ParseError(path, line,
+                       "a unit quaternion \"qx qy qz qw\" (|norm - 1| <= " +
+                           toString(kQuaternionNormTolerance) + ")",
+                       "norm " + toString(norm));
+    }
+    poses.push_back({v[0], Pose3(q, Eigen::Vector3d(v[1], v[2], v[3]))});
+  });
+  if (poses.empty()) {
+    throw ParseError(path, 0, std::string("at least one pose line \"") + kTrajectoryFormat + "\"",
+                     "none");
+  }
+  return poses;
+}
+
+void writeTrajectory(const std::string& path, const std::vector<StampedPose>& poses) {
+  std::ofstream out(path);
+  if (!out) throw IoError(path, "cannot open for writing");
+  // The global locale could otherwise turn the decimal point into a comma.
+  out.imbue(std::locale::classic());
+  out << std::fixed;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const StampedPose& pose = poses[i];
+    const Eigen::Vector3d& t = pose.world_from_cam.translation();
+    const Eigen::Quaterniond& q = pose.world_from_cam.rotation();
+    // "nan" would be written silently and then rejected by every reader.
+    CURVESFM_CHECK(std::isfinite(pose.timestamp) && t.allFinite() && q.coeffs().allFinite())
+        << "pose " << i << " of the trajectory for " << path << " is not finite";
+    out << std::setprecision(6) << pose.timestamp << std::setprecision(9) << ' ' << t.x() << ' '
+        << t.y() << ' ' << t.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w()
+        << '\n';
+  }
+  out.close();
+  if (!out) throw IoError(path, "write failed");
+}
+
+Camera readCameraYaml(const std::string& path) {
+  const std::string text = readWholeFile(path);
+  cv::FileStorage storage;
+  openYaml(path, text, &storage);
+  const cv::FileNode root = storage.root();
+  // OpenCV asserts (throws) on key lookups in a non-mapping root.
+  if (!root.isNone() && !root.isMap()) {
+    throw ParseError(path, 0, "a YAML mapping of Camera.* keys", describeNode(root));
+  }
+  const YamlFile file{path, text, storage};
+  CameraIntrinsics intrinsics;
+  intrinsics.fx = file.positiveNumber("Camera.fx");
+  intrinsics.fy = file.positiveNumber("Camera.fy");
+  intrinsics.cx = file.number("Camera.cx");
+  intrinsics.cy = file.number("Camera.cy");
+  intrinsics.k1 = file.number("Camera.k1", 0.0);
+  intrinsics.k2 = file.number("Camera.k2", 0.0);
+  intrinsics.p1 = file.number("Camera.p1", 0.0);
+  intrinsics.p2 = file.number("Camera.p2", 0.0);
+  intrinsics.k3 = file.number("Camera.k3", 0.0);
+  intrinsics.width = file.pixelCount("Camera.width");
+  intrinsics.height = file.pixelCount("Camera.height");
+  return Camera(intrinsics);
+}
+
+}  // namespace curvesfm

@@ -1,0 +1,64 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/pose3.h"
+
+namespace curvesfm {
+
+// Readers and writers for the dataset files of DESIGN.md "Data contracts" (TUM RGB-D layout and
+// ORB-SLAM2-style camera YAML).
+//
+// Errors, common to every reader:
+//   - a file that cannot be opened or read: IoError "<path>: cannot open for reading";
+//   - malformed content: ParseError "<path>:<line>: expected <what>, found <what>", with 1-based
+//     line numbers (line 0, i.e. no number, for the file as a whole, e.g. an empty file).
+// Text files: a line whose first non-blank character is '#' is a comment; blank lines are
+// skipped; fields are separated by spaces or tabs; CRLF line ends are accepted. Numbers are
+// parsed locale independently and must be finite, with no trailing characters.
+
+/// One line of a TUM `rgb.txt`.
+struct ImageEntry {
+  double timestamp = 0.0;  ///< Capture time in seconds (as written in the file).
+  std::string path;        ///< Image path, resolved relative to the folder holding rgb.txt.
+};
+
+/// Reads a TUM image list: lines "timestamp path". Relative paths are resolved against the folder
+/// holding `rgb_txt_path`; absolute paths are kept. Entries keep the file's order. Paths must not
+/// contain blanks. A list with no entries is a ParseError (line 0).
+std::vector<ImageEntry> readImageList(const std::string& rgb_txt_path);
+
+/// A timestamped camera pose.
+struct StampedPose {
+  double timestamp = 0.0;  ///< Seconds.
+  Pose3 world_from_cam;    ///< Camera-to-world: x_world = R x_cam + t (t is the camera centre).
+};
+
+/// |norm - 1| above which a trajectory quaternion is rejected instead of normalised. TUM files
+/// store ~4-9 decimals (norm error <= 1e-4); a larger error means a broken or misordered column.
+inline constexpr double kQuaternionNormTolerance = 1e-2;
+
+/// Reads a TUM trajectory: lines "timestamp tx ty tz qx qy qz qw", camera-to-world. Quaternions
+/// are normalised; one whose norm differs from 1 by more than kQuaternionNormTolerance (zero
+/// included) is a ParseError. Poses keep the file's order. An empty trajectory is a ParseError
+/// (line 0).
+std::vector<StampedPose> readTrajectory(const std::string& path);
+
+/// Writes a TUM trajectory with ORB-SLAM2's precision: one line per pose,
+/// "timestamp tx ty tz qx qy qz qw", fixed notation, timestamp with 6 decimals and the 7 pose
+/// values with 9, space separated, no header. `poses` may be empty (an empty file, which
+/// readTrajectory() rejects). Throws IoError if the file cannot be written.
+void writeTrajectory(const std::string& path, const std::vector<StampedPose>& poses);
+
+/// Reads an OpenCV FileStorage YAML camera file with ORB-SLAM2-style keys. Required: Camera.fx,
+/// Camera.fy (> 0), Camera.cx, Camera.cy, Camera.width, Camera.height (positive whole numbers);
+/// optional, default 0: Camera.k1, Camera.k2, Camera.p1, Camera.p2, Camera.k3. Other keys are
+/// ignored. The "%YAML:1.0" / "%YAML 1.0" header is optional.
+/// Errors: IoError if the file cannot be read; ParseError for YAML that OpenCV rejects (with the
+/// line OpenCV reports and its message), for a missing required key (line 0), and for a value
+/// that is not a finite number or out of range (with the key's line when it can be located).
+Camera readCameraYaml(const std::string& path);
+
+}  // namespace curvesfm

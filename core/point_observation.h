@@ -1,0 +1,15 @@
+#pragma once
+
+#include <Eigen/Core>
+
+namespace curvesfm {
+
+/// One image measurement of a 3D point: point `point_index` seen by camera `camera_index` at
+/// `pixel` (distorted pixel coordinates, pixel centres at integers).
+struct PointObservation {
+  int camera_index = 0;
+  int point_index = 0;
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
+};
+
+}  // namespace curvesfm

@@ -1,0 +1,116 @@
+#include "graph/ceres_manifolds.h"
+
+#include <Eigen/Core>
+
+#include "core/direction.h"
+#include "core/pose3.h"
+#include "core/so3.h"
+
+namespace curvesfm {
+namespace {
+
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// d(exp(w) * q)/dw at w = 0, in Eigen's coefficient order (x, y, z, w):
+// 0.5 * [qw I - [qv]x ; -qv^T]. Its columns are orthogonal with norm 1/2, so 4 P^T is the
+// left inverse used as MinusJacobian.
+Eigen::Matrix<double, 4, 3> quaternionPlusJacobian(const double* q) {
+  const Eigen::Vector3d qv(q[0], q[1], q[2]);
+  Eigen::Matrix<double, 4, 3> P;
+  P.topRows<3>() = 0.5 * (q[3] * Eigen::Matrix3d::Identity() - so3::hat(qv));
+  P.row(3) = -0.5 * qv.transpose();
+  return P;
+}
+
+}  // namespace
+
+bool PoseManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
+  Pose3::fromAmbient(x).retract(Vector6d::Map(delta)).toAmbient(x_plus_delta);
+  return true;
+}
+
+bool PoseManifold::PlusJacobian(const double* x, double* jacobian) const {
+  Eigen::Map<Eigen::Matrix<double, 7, 6, Eigen::RowMajor>> J(jacobian);
+  J.setZero();
+  J.topLeftCorner<4, 3>() = quaternionPlusJacobian(x);
+  J.bottomRightCorner<3, 3>().setIdentity();
+  return true;
+}
+
+bool PoseManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
+  Vector6d::Map(y_minus_x) = Pose3::fromAmbient(x).localCoordinates(Pose3::fromAmbient(y));
+  return true;
+}
+
+bool PoseManifold::MinusJacobian(const double* x, double* jacobian) const {
+  Eigen::Map<Eigen::Matrix<double, 6, 7, Eigen::RowMajor>> J(jacobian);
+  J.setZero();
+  J.topLeftCorner<3, 4>() = 4.0 * quaternionPlusJacobian(x).transpose();
+  J.bottomRightCorner<3, 3>().setIdentity();
+  return true;
+}
+
+bool DirectionManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
+  Direction::fromAmbient(x).retract(Eigen::Vector2d::Map(delta)).toAmbient(x_plus_delta);
+  return true;
+}
+
+bool DirectionManifold::PlusJacobian(const double* x, double* jacobian) const {
+  Eigen::Map<Eigen::Matrix<double, 3, 2, Eigen::RowMajor>> J(jacobian);
+  J = Direction::fromAmbient(x).basis();
+  return true;
+}
+
+bool DirectionManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
+  Eigen::Vector2d::Map(y_minus_x) =
+      Direction::fromAmbient(x).localCoordinates(Direction::fromAmbient(y));
+  return true;
+}
+
+bool DirectionManifold::MinusJacobian(const double* x, double* jacobian) const {
+  Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> J(jacobian);
+  J = Direction::fromAmbient(x).basis().transpose();
+  return true;
+}
+
+const ceres::Manifold* manifoldFor(VariableType type) {
+  static const PoseManifold pose_manifold;
+  static const DirectionManifold direction_manifold;
+  switch (type) {
+    case VariableType::kPose3: return &pose_manifold;
+    case VariableType::kDirection: return &direction_manifold;
+    case VariableType::kPoint3:
+    case VariableType::kScalar: return nullptr;
+  }
+  return nullptr;
+}
+
+void liftToAmbient(VariableType type, const double* x, const double* tangent_jacobian, int rows,
+                   double* ambient_jacobian) {
+  switch (type) {
+    case VariableType::kPose3: {
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>> Jt(
+          tangent_jacobian, rows, 6);
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> Ja(ambient_jacobian,
+                                                                                rows, 7);
+      Ja.leftCols<4>().noalias() =
+          Jt.leftCols<3>() * (4.0 * quaternionPlusJacobian(x).transpose());
+      Ja.rightCols<3>() = Jt.rightCols<3>();
+      return;
+    }
+    case VariableType::kDirection: {
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>> Jt(
+          tangent_jacobian, rows, 2);
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> Ja(ambient_jacobian,
+                                                                                rows, 3);
+      Ja.noalias() = Jt * Direction::fromAmbient(x).basis().transpose();
+      return;
+    }
+    case VariableType::kPoint3:
+    case VariableType::kScalar:
+      std::copy(tangent_jacobian, tangent_jacobian + rows * tangentDim(type), ambient_jacobian);
+      return;
+  }
+}
+
+}  // namespace curvesfm

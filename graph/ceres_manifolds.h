@@ -1,0 +1,42 @@
+#pragma once
+
+#include <ceres/manifold.h>
+
+#include "graph/variable_traits.h"
+
+namespace curvesfm {
+
+/// Pose3's chart as a Ceres manifold. Ambient [qx qy qz qw tx ty tz], tangent [w; u]:
+/// Plus(x, d) = (exp(w) * q, t + u), exactly Pose3::retract.
+class PoseManifold : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return 7; }
+  int TangentSize() const override { return 6; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+};
+
+/// Direction's chart as a Ceres manifold: ambient the unit 3-vector, tangent 2-D, Plus is
+/// Direction::retract (great-circle step along Direction::basis()).
+class DirectionManifold : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return 3; }
+  int TangentSize() const override { return 2; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+};
+
+/// The shared manifold for a variable type, or nullptr for Euclidean types (points, scalars).
+const ceres::Manifold* manifoldFor(VariableType type);
+
+/// Turns a tangent-space Jacobian J_t (rows x tangentDim, row-major) into the ambient-space
+/// Jacobian Ceres expects (rows x ambientDim, row-major), such that J_a * PlusJacobian(x) = J_t.
+/// We use J_a = J_t * MinusJacobian(x): both manifolds have MinusJacobian * PlusJacobian = I.
+void liftToAmbient(VariableType type, const double* x, const double* tangent_jacobian, int rows,
+                   double* ambient_jacobian);
+
+}  // namespace curvesfm

@@ -1,0 +1,66 @@
+// optimize() from graph/optimizer.h; it lives in a ceres_* file because it drives Ceres.
+#include <ceres/solver.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include "graph/ceres_problem.h"
+#include "graph/optimizer.h"
+
+namespace curvesfm {
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+OptimizationSummary optimize(const FactorGraph& graph, Values* values,
+                             const ProblemConfig& config, const OptimizerOptions& options) {
+  options.validate();
+  const auto start = std::chrono::steady_clock::now();
+  OptimizationSummary summary;
+  summary.num_factors = static_cast<int>(graph.size());
+  summary.initial_cost_by_type = graph.costByType(*values);
+
+  CeresProblem bridge(graph, *values, config);
+  ceres::Solver::Options ceres_options = toCeresOptions(options);
+  summary.ordering = "automatic";
+  if (options.structure_first_ordering) {
+    std::string why_not;
+    ceres_options.linear_solver_ordering = bridge.structureFirstOrdering(&why_not);
+    summary.ordering = ceres_options.linear_solver_ordering ? "structure_first"
+                                                            : "automatic (" + why_not + ")";
+  }
+  summary.num_constant_variables = bridge.numConstant();
+  summary.num_free_variables = static_cast<int>(bridge.keys().size()) - bridge.numConstant();
+  summary.setup_seconds = secondsSince(start);
+
+  const auto solve_start = std::chrono::steady_clock::now();
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(ceres_options, &bridge.problem(), &ceres_summary);
+  summary.solve_seconds = secondsSince(solve_start);
+
+  const auto writeback_start = std::chrono::steady_clock::now();
+  bridge.writeBack(values);
+  summary.final_cost_by_type = graph.costByType(*values);
+  summary.writeback_seconds = secondsSince(writeback_start);
+
+  summary.initial_cost = ceres_summary.initial_cost;
+  summary.final_cost = ceres_summary.final_cost;
+  // Ceres lists iteration 0 (the starting point) too.
+  summary.iterations = std::max(0, static_cast<int>(ceres_summary.iterations.size()) - 1);
+  summary.usable = ceres_summary.IsSolutionUsable();
+  summary.termination = ceres::TerminationTypeToString(ceres_summary.termination_type);
+  summary.message = ceres_summary.message;
+  summary.linear_solver = ceres::LinearSolverTypeToString(ceres_summary.linear_solver_type_used);
+  summary.num_residuals = ceres_summary.num_residuals;
+  summary.num_effective_parameters = ceres_summary.num_effective_parameters;
+  summary.minimizer_seconds = ceres_summary.minimizer_time_in_seconds;
+  summary.full_report = ceres_summary.FullReport();
+  summary.total_seconds = secondsSince(start);
+  return summary;
+}
+
+}  // namespace curvesfm

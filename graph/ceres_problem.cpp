@@ -1,0 +1,138 @@
+#include "graph/ceres_problem.h"
+
+#include "graph/ceres_manifolds.h"
+
+namespace curvesfm {
+
+CeresProblem::CeresProblem(const FactorGraph& graph, const Values& values,
+                           const ProblemConfig& config)
+    : config_(config) {
+  // Parameter blocks must not move once Ceres holds pointers: size the storage first.
+  std::size_t total = 0;
+  std::unordered_map<Key, VariableType> used;
+  for (const auto& factor : graph) {
+    const std::vector<VariableType> expected = factor->variableTypes();
+    for (std::size_t i = 0; i < factor->keys().size(); ++i) {
+      const Key key = factor->keys()[i];
+      const VariableType stored = values.type(key);
+      if (stored != expected[i]) throw IncorrectType(key, stored, expected[i]);
+      if (used.emplace(key, stored).second) total += ambientDim(stored);
+    }
+  }
+  storage_.reserve(total);
+
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_ = std::make_unique<ceres::Problem>(problem_options);
+
+  std::vector<double*> blocks;
+  for (const auto& factor : graph) {
+    blocks.clear();
+    for (Key key : factor->keys()) {
+      if (!offsets_.count(key)) addVariable(key, used.at(key), values, config);
+      blocks.push_back(storage_.data() + offsets_.at(key));
+    }
+    problem_->AddResidualBlock(new FactorCostFunction(factor),
+                               const_cast<ceres::LossFunction*>(lossFor(factor->noiseModel().kernel)),
+                               blocks);
+    factor_keys_.push_back(factor->keys());
+  }
+}
+
+void CeresProblem::addVariable(Key key, VariableType type, const Values& values,
+                               const ProblemConfig& config) {
+  const std::size_t offset = storage_.size();
+  storage_.resize(offset + ambientDim(type));
+  values.toAmbient(key, storage_.data() + offset);
+  offsets_.emplace(key, offset);
+  keys_.push_back(key);
+  types_.push_back(type);
+  double* block = storage_.data() + offset;
+  problem_->AddParameterBlock(block, ambientDim(type),
+                              const_cast<ceres::Manifold*>(manifoldFor(type)));
+  if (config.isConstant(key)) {
+    problem_->SetParameterBlockConstant(block);
+    ++num_constant_;
+  }
+}
+
+const ceres::LossFunction* CeresProblem::lossFor(const RobustKernel& kernel) {
+  if (kernel.type() == RobustKernelType::kNone) return nullptr;
+  // Factors of one kind share one kernel: keep one loss object per distinct kernel.
+  for (const auto& loss : losses_) {
+    const RobustKernel& existing = loss->kernel();
+    if (existing.type() == kernel.type() && existing.width() == kernel.width()) return loss.get();
+  }
+  losses_.push_back(std::make_unique<RobustLoss>(kernel));
+  return losses_.back().get();
+}
+
+double* CeresProblem::block(Key key) {
+  const auto it = offsets_.find(key);
+  return it == offsets_.end() ? nullptr : storage_.data() + it->second;
+}
+
+void CeresProblem::writeBack(Values* values) const {
+  for (const Key key : keys_) values->setFromAmbient(key, storage_.data() + offsets_.at(key));
+}
+
+std::shared_ptr<ceres::ParameterBlockOrdering> CeresProblem::structureFirstOrdering(
+    std::string* why_not) const {
+  auto isFreeStructure = [this](Key key) {
+    return categoryOf(key) != VariableCategory::kPose && !config_.isConstant(key);
+  };
+  for (const auto& keys : factor_keys_) {
+    Key first_structure;
+    bool seen = false;
+    for (Key key : keys) {
+      if (!isFreeStructure(key)) continue;
+      if (seen && key != first_structure) {
+        *why_not = "factor couples " + first_structure.toString() + " and " + key.toString();
+        return nullptr;
+      }
+      first_structure = key;
+      seen = true;
+    }
+  }
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (std::size_t i = 0; i < keys_.size(); ++i) {
+    double* block = const_cast<double*>(storage_.data()) + offsets_.at(keys_[i]);
+    ordering->AddElementToGroup(block, categoryOf(keys_[i]) == VariableCategory::kPose ? 1 : 0);
+  }
+  return ordering;
+}
+
+ceres::Solver::Options toCeresOptions(const OptimizerOptions& options) {
+  ceres::Solver::Options ceres_options;
+  switch (options.linear_solver) {
+    case LinearSolver::kSparseSchur:
+      ceres_options.linear_solver_type = ceres::SPARSE_SCHUR;
+      break;
+    case LinearSolver::kDenseSchur:
+      ceres_options.linear_solver_type = ceres::DENSE_SCHUR;
+      break;
+    case LinearSolver::kIterativeSchur:
+      ceres_options.linear_solver_type = ceres::ITERATIVE_SCHUR;
+      ceres_options.preconditioner_type = ceres::SCHUR_JACOBI;
+      break;
+    case LinearSolver::kSparseNormalCholesky:
+      ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+      break;
+  }
+  ceres_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  ceres_options.trust_region_strategy_type = options.trust_region == TrustRegion::kDogleg
+                                                 ? ceres::DOGLEG
+                                                 : ceres::LEVENBERG_MARQUARDT;
+  ceres_options.max_num_iterations = options.max_iterations;
+  ceres_options.num_threads = options.num_threads;
+  ceres_options.function_tolerance = options.function_tolerance;
+  ceres_options.gradient_tolerance = options.gradient_tolerance;
+  ceres_options.parameter_tolerance = options.parameter_tolerance;
+  ceres_options.use_inner_iterations = options.use_inner_iterations;
+  ceres_options.minimizer_progress_to_stdout = options.verbose;
+  ceres_options.logging_type = options.verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  return ceres_options;
+}
+
+}  // namespace curvesfm

@@ -1,0 +1,63 @@
+#pragma once
+
+#include <ceres/ordered_groups.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "graph/ceres_cost_function.h"
+#include "graph/factor_graph.h"
+#include "graph/optimizer.h"
+#include "graph/values.h"
+
+namespace curvesfm {
+
+/// The bridge from a factor graph to a ceres::Problem. It copies the variables that factors use
+/// into its own parameter blocks (ambient coordinates), attaches manifolds, robust losses and
+/// constant flags, and copies results back with writeBack().
+class CeresProblem {
+ public:
+  /// Throws KeyDoesNotExist / IncorrectType for a factor key missing from or mistyped in
+  /// `values`.
+  CeresProblem(const FactorGraph& graph, const Values& values, const ProblemConfig& config);
+  CeresProblem(const CeresProblem&) = delete;
+  CeresProblem& operator=(const CeresProblem&) = delete;
+
+  ceres::Problem& problem() { return *problem_; }
+  /// The parameter block of `key` (ambient coordinates); nullptr if no factor uses it.
+  double* block(Key key);
+  /// Keys of all parameter blocks, in the order they were added.
+  const std::vector<Key>& keys() const { return keys_; }
+  int numConstant() const { return num_constant_; }
+
+  /// Copies every parameter block back into `values`.
+  void writeBack(Values* values) const;
+
+  /// Schur ordering with every free non-pose variable in group 0 and the poses in group 1.
+  /// Returns nullptr and sets `why_not` if two free non-pose variables share a factor, since
+  /// the eliminated group must be an independent set.
+  std::shared_ptr<ceres::ParameterBlockOrdering> structureFirstOrdering(std::string* why_not) const;
+
+ private:
+  void addVariable(Key key, VariableType type, const Values& values, const ProblemConfig& config);
+  const ceres::LossFunction* lossFor(const RobustKernel& kernel);
+
+  std::unique_ptr<ceres::Problem> problem_;
+  std::vector<Key> keys_;
+  std::unordered_map<Key, std::size_t> offsets_;
+  std::vector<VariableType> types_;
+  std::vector<double> storage_;
+  std::vector<std::unique_ptr<RobustLoss>> losses_;
+  std::vector<std::vector<Key>> factor_keys_;
+  int num_constant_ = 0;
+  ProblemConfig config_;
+};
+
+/// Maps our options onto Ceres' (linear solver, preconditioner, trust region, tolerances...).
+ceres::Solver::Options toCeresOptions(const OptimizerOptions& options);
+
+}  // namespace curvesfm

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "graph/factor.h"
+#include "graph/values.h"
+
+namespace curvesfm {
+
+/// Cost of all factors of one type.
+struct FactorTypeCost {
+  int count = 0;      ///< Number of factors of this type.
+  double cost = 0.0;  ///< Sum of 0.5 * rho(|r / sigma|^2) over them (Ceres' convention).
+};
+
+/// A list of factors sharing variables by key. Factors are immutable and shared, so a graph is
+/// cheap to copy and a solver may hold them while the graph changes.
+class FactorGraph {
+ public:
+  using FactorPtr = std::shared_ptr<const Factor>;
+
+  void add(FactorPtr factor);
+  template <class F, class... Args>
+  void emplace(Args&&... args) {
+    add(std::make_shared<const F>(std::forward<Args>(args)...));
+  }
+
+  std::size_t size() const { return factors_.size(); }
+  bool empty() const { return factors_.empty(); }
+  const FactorPtr& operator[](std::size_t i) const { return factors_[i]; }
+  auto begin() const { return factors_.begin(); }
+  auto end() const { return factors_.end(); }
+
+  /// Total cost 0.5 * sum rho(|r_i / sigma_i|^2) at `values`.
+  double cost(const Values& values) const;
+  /// Cost per factor typeName() at `values`.
+  std::map<std::string, FactorTypeCost> costByType(const Values& values) const;
+
+ private:
+  std::vector<FactorPtr> factors_;
+};
+
+}  // namespace curvesfm

@@ -9,7 +9,8 @@ Pose3::Pose3(const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translat
     : rotation_(rotation), translation_(translation) {
   const double norm = rotation_.norm();
   CURVESFM_CHECK(norm > 1e-12) << "Pose3 needs a non-zero quaternion";
-  rotation_.coeffs() /= norm;
+  // q and -q are one rotation; keeping qw >= 0 makes the ambient form unique.
+  rotation_.coeffs() /= rotation_.w() < 0.0 ? -norm : norm;
 }
 
 Pose3::Pose3(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation)

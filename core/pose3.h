@@ -13,7 +13,7 @@ namespace curvesfm {
 /// Tangent space (the chart used by the optimiser and all Jacobians), delta = [w; u]:
 ///   retract(delta) = (exp(w) * R, t + u)
 /// i.e. a rotation perturbation on the left (in the target frame) and an additive translation.
-/// Ambient storage for solvers: 7 doubles [qx, qy, qz, qw, tx, ty, tz] (Eigen's order).
+/// Ambient storage for solvers: 7 doubles [qx, qy, qz, qw, tx, ty, tz] (Eigen's order), qw >= 0.
 class Pose3 {
  public:
   static constexpr int kTangentDim = 6;
@@ -21,7 +21,7 @@ class Pose3 {
 
   /// The identity transform.
   Pose3() : rotation_(Eigen::Quaterniond::Identity()), translation_(Eigen::Vector3d::Zero()) {}
-  /// `rotation` is normalised; it must not be zero.
+  /// `rotation` is normalised (and its sign chosen so that qw >= 0); it must not be zero.
   Pose3(const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation);
   Pose3(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation);
 

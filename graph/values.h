@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <variant>
 #include <vector>
@@ -30,6 +31,11 @@ class KeyAlreadyExists : public Error {
   explicit KeyAlreadyExists(Key key);
 };
 
+/// The type a value is stored as: Eigen expressions (e.g. Eigen::Vector3d::Zero()) as points.
+template <class T>
+using StoredType =
+    std::conditional_t<std::is_base_of_v<Eigen::EigenBase<T>, T>, Eigen::Vector3d, T>;
+
 /// The variables of a factor graph, by key. Each holds one of Pose3, Eigen::Vector3d (point),
 /// Direction or double (scalar); VariableTraits says how each is stored and perturbed.
 class Values {
@@ -39,12 +45,14 @@ class Values {
   /// Adds a new variable; throws KeyAlreadyExists if `key` is taken.
   template <class T>
   void insert(Key key, const T& value) {
-    if (!variables_.emplace(key, Variable(value)).second) throw KeyAlreadyExists(key);
+    if (!variables_.emplace(key, Variable(StoredType<T>(value))).second) {
+      throw KeyAlreadyExists(key);
+    }
   }
   /// Replaces an existing variable of the same type; throws KeyDoesNotExist / IncorrectType.
   template <class T>
   void update(Key key, const T& value) {
-    mutableAt<T>(key) = value;
+    mutableAt<StoredType<T>>(key) = value;
   }
   /// Typed read access; throws KeyDoesNotExist / IncorrectType.
   template <class T>

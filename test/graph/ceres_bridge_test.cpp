@@ -1,0 +1,251 @@
+#include <ceres/gradient_checker.h>
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/so3.h"
+#include "graph/ceres_cost_function.h"
+#include "graph/ceres_manifolds.h"
+#include "graph/ceres_problem.h"
+#include "graph/optimizer.h"
+#include "test/graph/test_factors.h"
+#include "test/support/numerical_jacobian.h"
+
+namespace curvesfm {
+namespace {
+
+using testing::AllTypesFactor;
+using testing::PointPriorFactor;
+
+Values randomValues(std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Values values;
+  values.insert(poseKey(0), Pose3(so3::exp(Eigen::Vector3d(n(rng), n(rng), n(rng))),
+                                  Eigen::Vector3d(n(rng), n(rng), n(rng))));
+  values.insert(pointKey(0), Eigen::Vector3d(n(rng), n(rng), n(rng)));
+  values.insert(directionKey(0, 0), Direction(Eigen::Vector3d(n(rng), n(rng), n(rng))));
+  values.insert(startLengthKey(0, 0), 1.0 + 0.3 * n(rng));
+  return values;
+}
+
+std::shared_ptr<const AllTypesFactor> allTypesFactor(const NoiseModel& noise = {}) {
+  return std::make_shared<const AllTypesFactor>(poseKey(0), pointKey(0), directionKey(0, 0),
+                                                startLengthKey(0, 0),
+                                                Eigen::Vector3d(0.5, -1.0, 2.0), noise);
+}
+
+TEST(NoiseModelFactorN, AnalyticJacobiansMatchNumerical) {
+  std::mt19937 rng(10);
+  const auto factor = allTypesFactor();
+  for (int trial = 0; trial < 50; ++trial) {
+    testing::expectJacobiansMatchNumerical(*factor, randomValues(rng));
+  }
+}
+
+TEST(FactorCostFunction, PassesCeresGradientChecker) {
+  std::mt19937 rng(11);
+  const auto factor = allTypesFactor(NoiseModel{0.5, {}});
+  FactorCostFunction cost(factor);
+  const std::vector<const ceres::Manifold*> manifolds = {
+      manifoldFor(VariableType::kPose3), nullptr, manifoldFor(VariableType::kDirection), nullptr};
+  ceres::NumericDiffOptions numeric_options;
+  ceres::GradientChecker checker(&cost, &manifolds, numeric_options);
+  for (int trial = 0; trial < 20; ++trial) {
+    const Values values = randomValues(rng);
+    std::vector<std::vector<double>> blocks;
+    std::vector<const double*> pointers;
+    for (Key key : factor->keys()) {
+      blocks.emplace_back(ambientDim(values.type(key)));
+      values.toAmbient(key, blocks.back().data());
+    }
+    for (const auto& block : blocks) pointers.push_back(block.data());
+    // Probe's own verdict is purely relative, so it flags the structural zeros of [R p]x
+    // (1e-17 against 1e-14); compare its Jacobians with a mixed tolerance instead.
+    ceres::GradientChecker::ProbeResults results;
+    checker.Probe(pointers.data(), 1e-7, &results);
+    ASSERT_TRUE(results.return_value);
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      const auto& user = results.local_jacobians[i];
+      const auto& numeric = results.local_numeric_jacobians[i];
+      EXPECT_LT((user - numeric).cwiseAbs().maxCoeff(),
+                1e-7 * std::max(1.0, numeric.cwiseAbs().maxCoeff()))
+          << "block " << i << "\n" << results.error_log;
+      EXPECT_LT((results.jacobians[i] - results.numeric_jacobians[i]).cwiseAbs().maxCoeff(),
+                1e-7 * std::max(1.0, results.numeric_jacobians[i].cwiseAbs().maxCoeff()))
+          << "ambient block " << i;
+    }
+  }
+}
+
+TEST(FactorCostFunction, WhitensResidualsBySigma) {
+  std::mt19937 rng(12);
+  const Values values = randomValues(rng);
+  const auto factor = allTypesFactor(NoiseModel{0.25, {}});
+  FactorCostFunction cost(factor);
+  std::vector<std::vector<double>> blocks;
+  std::vector<const double*> pointers;
+  for (Key key : factor->keys()) {
+    blocks.emplace_back(ambientDim(values.type(key)));
+    values.toAmbient(key, blocks.back().data());
+  }
+  for (const auto& block : blocks) pointers.push_back(block.data());
+  Eigen::Vector3d residual;
+  ASSERT_TRUE(cost.Evaluate(pointers.data(), residual.data(), nullptr));
+  EXPECT_TRUE(residual.isApprox(factor->unwhitenedError(values) / 0.25));
+}
+
+// Pose, point, direction and scale pinned by enough factors to have a unique optimum.
+struct ToyProblem {
+  FactorGraph graph;
+  Values truth;
+  Values start;
+};
+
+ToyProblem makeToyProblem() {
+  std::mt19937 rng(13);
+  ToyProblem toy;
+  toy.truth = randomValues(rng);
+  const Pose3& pose = toy.truth.at<Pose3>(poseKey(0));
+  const auto& point = toy.truth.at<Eigen::Vector3d>(pointKey(0));
+  const auto& direction = toy.truth.at<Direction>(directionKey(0, 0));
+  const double scale = toy.truth.at<double>(startLengthKey(0, 0));
+  // The same point, direction and scale seen through several pose-like observations.
+  for (int i = 0; i < 4; ++i) {
+    const Key pose_key = poseKey(i + 1);
+    const Pose3 other = Pose3(so3::exp(Eigen::Vector3d(0.3 * i, -0.2, 0.1 * i)),
+                              Eigen::Vector3d(i, 1.0 - i, 0.5));
+    toy.truth.insert(pose_key, other);
+    toy.graph.emplace<AllTypesFactor>(pose_key, pointKey(0), directionKey(0, 0),
+                                      startLengthKey(0, 0),
+                                      other * (point + scale * direction.vector()));
+  }
+  toy.graph.emplace<AllTypesFactor>(poseKey(0), pointKey(0), directionKey(0, 0),
+                                    startLengthKey(0, 0), pose * (point + scale * direction.vector()));
+  toy.graph.emplace<PointPriorFactor>(pointKey(0), point);
+  toy.start = toy.truth;
+  toy.start.update(pointKey(0), Eigen::Vector3d(point + Eigen::Vector3d(0.2, -0.1, 0.1)));
+  toy.start.update(directionKey(0, 0), direction.retract(Eigen::Vector2d(0.2, -0.1)));
+  toy.start.update(startLengthKey(0, 0), scale * 1.2);
+  return toy;
+}
+
+ProblemConfig posesConstant() {
+  ProblemConfig config;
+  config.setConstant(VariableCategory::kPose);
+  return config;
+}
+
+TEST(Optimize, RecoversTheOptimumWithPosesConstant) {
+  ToyProblem toy = makeToyProblem();
+  Values values = toy.start;
+  OptimizerOptions options;
+  options.function_tolerance = 1e-14;
+  options.gradient_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-14;
+  options.linear_solver = LinearSolver::kDenseSchur;
+  const OptimizationSummary summary = optimize(toy.graph, &values, posesConstant(), options);
+  EXPECT_TRUE(summary.usable) << summary.message;
+  EXPECT_LT(summary.final_cost, 1e-16);
+  EXPECT_GT(summary.initial_cost, 1e-3);
+  EXPECT_LT((values.at<Eigen::Vector3d>(pointKey(0)) -
+             toy.truth.at<Eigen::Vector3d>(pointKey(0)))
+                .norm(),
+            1e-8);
+  EXPECT_LT(values.at<Direction>(directionKey(0, 0))
+                .angleTo(toy.truth.at<Direction>(directionKey(0, 0))),
+            1e-8);
+  EXPECT_NEAR(values.at<double>(startLengthKey(0, 0)), toy.truth.at<double>(startLengthKey(0, 0)),
+              1e-8);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_TRUE(values.at<Pose3>(poseKey(i)).translation() ==
+                toy.truth.at<Pose3>(poseKey(i)).translation());
+  }
+  EXPECT_EQ(summary.num_constant_variables, 5);
+  EXPECT_EQ(summary.num_free_variables, 3);
+}
+
+TEST(Optimize, ReportsCostsInCeresConventionPerType) {
+  ToyProblem toy = makeToyProblem();
+  Values values = toy.start;
+  const double start_cost = toy.graph.cost(values);
+  const OptimizationSummary summary =
+      optimize(toy.graph, &values, posesConstant(), OptimizerOptions());
+  EXPECT_NEAR(summary.initial_cost, start_cost, 1e-12 * start_cost);
+  ASSERT_EQ(summary.initial_cost_by_type.size(), 2u);
+  EXPECT_EQ(summary.initial_cost_by_type.at("all_types").count, 5);
+  EXPECT_EQ(summary.initial_cost_by_type.at("point_prior").count, 1);
+  double sum = 0;
+  for (const auto& entry : summary.final_cost_by_type) sum += entry.second.cost;
+  EXPECT_NEAR(sum, summary.final_cost, 1e-9 + 1e-9 * summary.final_cost);
+  EXPECT_NE(summary.toString().find("all_types"), std::string::npos);
+}
+
+TEST(Optimize, RobustLossIsTheKernelOfTheNoiseModel) {
+  Values values;
+  values.insert(pointKey(0), Eigen::Vector3d(10, 0, 0));
+  FactorGraph graph;
+  const NoiseModel huber{1.0, RobustKernel(RobustKernelType::kHuber, 1.0)};
+  graph.emplace<PointPriorFactor>(pointKey(0), Eigen::Vector3d::Zero(), huber);
+  OptimizerOptions options;
+  options.max_iterations = 0;
+  const OptimizationSummary summary = optimize(graph, &values, ProblemConfig(), options);
+  EXPECT_NEAR(summary.initial_cost, 0.5 * (2 * 10.0 - 1.0), 1e-12);
+}
+
+TEST(Optimize, EverySolverChoiceConverges) {
+  for (LinearSolver solver : {LinearSolver::kSparseSchur, LinearSolver::kDenseSchur,
+                              LinearSolver::kIterativeSchur, LinearSolver::kSparseNormalCholesky}) {
+    for (TrustRegion region : {TrustRegion::kLevenbergMarquardt, TrustRegion::kDogleg}) {
+      ToyProblem toy = makeToyProblem();
+      Values values = toy.start;
+      OptimizerOptions options;
+      options.linear_solver = solver;
+      options.trust_region = region;
+      const OptimizationSummary summary = optimize(toy.graph, &values, posesConstant(), options);
+      EXPECT_LT(summary.final_cost, 1e-8) << toString(solver) << " " << toString(region);
+    }
+  }
+}
+
+TEST(Optimize, FallsBackToAutomaticOrderingWhenStructureIsCoupled) {
+  ToyProblem toy = makeToyProblem();
+  Values values = toy.start;
+  const OptimizationSummary summary =
+      optimize(toy.graph, &values, posesConstant(), OptimizerOptions());
+  // AllTypesFactor ties the point, direction and scale together: not an independent set.
+  EXPECT_EQ(summary.ordering.rfind("automatic (factor couples", 0), 0u) << summary.ordering;
+}
+
+TEST(Optimize, MissingOrMistypedVariablesThrowBeforeSolving) {
+  ToyProblem toy = makeToyProblem();
+  Values missing = toy.start;
+  missing.erase(pointKey(0));
+  EXPECT_THROW(optimize(toy.graph, &missing, ProblemConfig(), OptimizerOptions()),
+               KeyDoesNotExist);
+  Values mistyped = toy.start;
+  mistyped.erase(startLengthKey(0, 0));
+  mistyped.insert(startLengthKey(0, 0), Eigen::Vector3d::Zero());
+  EXPECT_THROW(optimize(toy.graph, &mistyped, ProblemConfig(), OptimizerOptions()),
+               IncorrectType);
+}
+
+TEST(OptimizerOptions, ValidateNamesFieldAndValue) {
+  OptimizerOptions options;
+  options.num_threads = 0;
+  try {
+    options.validate();
+    FAIL();
+  } catch (const InvalidOptions& e) {
+    EXPECT_NE(std::string(e.what()).find("OptimizerOptions.num_threads = 0"), std::string::npos)
+        << e.what();
+  }
+  options = OptimizerOptions();
+  options.function_tolerance = -1;
+  EXPECT_THROW(options.validate(), InvalidOptions);
+  EXPECT_EQ(parseLinearSolver("iterative_schur", "x"), LinearSolver::kIterativeSchur);
+  EXPECT_THROW(parseLinearSolver("cholesky", "linear_solver"), InvalidOptions);
+  EXPECT_EQ(parseTrustRegion("dogleg", "x"), TrustRegion::kDogleg);
+}
+
+}  // namespace
+}  // namespace curvesfm

@@ -1,0 +1,59 @@
+#pragma once
+
+// A factor over every variable type, so the graph layer is tested without concrete factors:
+//   e = pose * (point + scale * direction) - target      (3 rows)
+
+#include "core/so3.h"
+#include "graph/factor.h"
+
+namespace curvesfm::testing {
+
+class AllTypesFactor
+    : public NoiseModelFactorN<3, Pose3, Eigen::Vector3d, Direction, double> {
+  using Base = NoiseModelFactorN<3, Pose3, Eigen::Vector3d, Direction, double>;
+
+ public:
+  AllTypesFactor(Key pose, Key point, Key direction, Key scale, const Eigen::Vector3d& target,
+                 NoiseModel noise = {})
+      : Base({pose, point, direction, scale}, noise), target_(target) {}
+
+  Error evaluateError(const Pose3& pose, const Eigen::Vector3d& point, const Direction& direction,
+                      const double& scale, Jacobian<Pose3>* H_pose,
+                      Jacobian<Eigen::Vector3d>* H_point, Jacobian<Direction>* H_direction,
+                      Jacobian<double>* H_scale) const override {
+    const Eigen::Matrix3d R = pose.rotationMatrix();
+    const Eigen::Vector3d local = point + scale * direction.vector();
+    if (H_pose) {
+      H_pose->leftCols<3>() = -so3::hat(R * local);
+      H_pose->rightCols<3>().setIdentity();
+    }
+    if (H_point) *H_point = R;
+    if (H_direction) *H_direction = scale * R * direction.basis();
+    if (H_scale) *H_scale = R * direction.vector();
+    return R * local + pose.translation() - target_;
+  }
+  const char* typeName() const override { return "all_types"; }
+
+ private:
+  Eigen::Vector3d target_;
+};
+
+/// e = point - target (3 rows): a prior that pins a point.
+class PointPriorFactor : public NoiseModelFactorN<3, Eigen::Vector3d> {
+  using Base = NoiseModelFactorN<3, Eigen::Vector3d>;
+
+ public:
+  PointPriorFactor(Key point, const Eigen::Vector3d& target, NoiseModel noise = {})
+      : Base({point}, noise), target_(target) {}
+  Error evaluateError(const Eigen::Vector3d& point,
+                      Jacobian<Eigen::Vector3d>* H) const override {
+    if (H) H->setIdentity();
+    return point - target_;
+  }
+  const char* typeName() const override { return "point_prior"; }
+
+ private:
+  Eigen::Vector3d target_;
+};
+
+}  // namespace curvesfm::testing

@@ -12,14 +12,15 @@ namespace curvesfm {
 namespace {
 
 void printErrors(const char* label, const PointSceneErrors& errors) {
-  std::printf("%-8s camera position rmse %.6f m, rotation mean %.5f deg, point rmse %.6f m, "
-              "reprojection rmse %.4f px\n",
-              label, errors.position_rmse, errors.rotation_mean_deg, errors.point_rmse,
-              errors.reprojection_rmse_px);
+  std::printf("%-8s camera ATE (sim3) %.6f m, position rmse %.6f m, rotation mean %.5f deg, "
+              "point rmse %.6f m, reprojection rmse %.4f px\n",
+              label, errors.position_ate_sim3, errors.position_rmse, errors.rotation_mean_deg,
+              errors.point_rmse, errors.reprojection_rmse_px);
 }
 
 nlohmann::json errorsToJson(const PointSceneErrors& errors) {
-  return {{"camera_position_rmse_m", errors.position_rmse},
+  return {{"camera_ate_sim3_m", errors.position_ate_sim3},
+          {"camera_position_rmse_m", errors.position_rmse},
           {"rotation_mean_deg", errors.rotation_mean_deg},
           {"point_rmse_m", errors.point_rmse},
           {"reprojection_rmse_px", errors.reprojection_rmse_px}};

@@ -69,27 +69,34 @@ struct BenchOptions {
 
 // --- the hand-written residuals ------------------------------------------------------------
 
-// point_in_cam = R(q) point + t for an ambient pose [qx qy qz qw tx ty tz]. The quaternion is
-// normalised first, as Pose3::fromAmbient does, so that the ambient Jacobian has no component
-// along q: then it equals FactorCostFunction's lifted Jacobian J_t * MinusJacobian exactly.
+// R(q) of an ambient pose [qx qy qz qw tx ty tz], row-major. The quaternion is normalised, as
+// Pose3::fromAmbient does (here through the 2 / |q|^2 factor), so the ambient Jacobian has no
+// component along q and equals FactorCostFunction's lifted Jacobian J_t * MinusJacobian.
 template <class T>
 void rotationMatrix(const T* pose, T R[9]) {
-  using std::sqrt;
-  const T norm = sqrt(pose[0] * pose[0] + pose[1] * pose[1] + pose[2] * pose[2] +
-                      pose[3] * pose[3]);
-  const T x = pose[0] / norm;
-  const T y = pose[1] / norm;
-  const T z = pose[2] / norm;
-  const T w = pose[3] / norm;
-  R[0] = T(1) - T(2) * (y * y + z * z);
-  R[1] = T(2) * (x * y - w * z);
-  R[2] = T(2) * (x * z + w * y);
-  R[3] = T(2) * (x * y + w * z);
-  R[4] = T(1) - T(2) * (x * x + z * z);
-  R[5] = T(2) * (y * z - w * x);
-  R[6] = T(2) * (x * z - w * y);
-  R[7] = T(2) * (y * z + w * x);
-  R[8] = T(1) - T(2) * (x * x + y * y);
+  const T& x = pose[0];
+  const T& y = pose[1];
+  const T& z = pose[2];
+  const T& w = pose[3];
+  const T s = 2.0 / (x * x + y * y + z * z + w * w);
+  const T xx = s * x * x;
+  const T yy = s * y * y;
+  const T zz = s * z * z;
+  const T xy = s * x * y;
+  const T xz = s * x * z;
+  const T yz = s * y * z;
+  const T wx = s * w * x;
+  const T wy = s * w * y;
+  const T wz = s * w * z;
+  R[0] = 1.0 - (yy + zz);
+  R[1] = xy - wz;
+  R[2] = xz + wy;
+  R[3] = xy + wz;
+  R[4] = 1.0 - (xx + zz);
+  R[5] = yz - wx;
+  R[6] = xz - wy;
+  R[7] = yz + wx;
+  R[8] = 1.0 - (xx + yy);
 }
 
 // Camera::project's model: pinhole with radial-tangential distortion (k1, k2, p1, p2, k3), and
@@ -111,15 +118,16 @@ struct ReprojectionFunctor {
     }
     const T px = R[0] * point[0] + R[1] * point[1] + R[2] * point[2] + pose[4];
     const T py = R[3] * point[0] + R[4] * point[1] + R[5] * point[2] + pose[5];
-    const T x = px / pz;
-    const T y = py / pz;
+    const T inverse_z = 1.0 / pz;
+    const T x = px * inverse_z;
+    const T y = py * inverse_z;
     const T xx = x * x;
     const T yy = y * y;
     const T xy = x * y;
     const T r2 = xx + yy;
-    const T radial = T(1) + r2 * (c.k1 + r2 * (c.k2 + r2 * c.k3));
-    const T xd = x * radial + T(2 * c.p1) * xy + c.p2 * (r2 + T(2) * xx);
-    const T yd = y * radial + c.p1 * (r2 + T(2) * yy) + T(2 * c.p2) * xy;
+    const T radial = 1.0 + r2 * (c.k1 + r2 * (c.k2 + r2 * c.k3));
+    const T xd = x * radial + (2.0 * c.p1) * xy + c.p2 * (r2 + 2.0 * xx);
+    const T yd = y * radial + c.p1 * (r2 + 2.0 * yy) + (2.0 * c.p2) * xy;
     residual[0] = (c.fx * xd + c.cx - measured.x()) * inverse_sigma;
     residual[1] = (c.fy * yd + c.cy - measured.y()) * inverse_sigma;
     return true;
@@ -175,6 +183,7 @@ using CameraDistanceCost = ceres::AutoDiffCostFunction<CameraDistanceFunctor, 1,
 struct SolveResult {
   double total_seconds = 0.0;   ///< Scene data in, optimised poses and points out.
   double build_seconds = 0.0;   ///< Building the problem (graph: graph + Values + bridge).
+  double finish_seconds = 0.0;  ///< Results out (graph: write-back, final costs, extraction).
   double solve_seconds = 0.0;   ///< ceres::Solve wall time.
   double minimizer_seconds = 0.0;
   int iterations = 0;
@@ -203,10 +212,13 @@ SolveResult solveWithGraph(const PointScene& scene, const PointBundleAdjustmentO
   const double graph_seconds = secondsSince(start);
   const OptimizationSummary summary =
       optimize(problem.graph, &problem.values, problem.config, optimizer);
+  const auto extract_start = Clock::now();
   result.poses = extractPoses(problem.values, scene.initial_cam_from_world.size());
   result.points = extractPoints(problem.values, scene.initial_points.size());
+  const double extract_seconds = secondsSince(extract_start);
   result.total_seconds = secondsSince(start);
   result.build_seconds = graph_seconds + summary.setup_seconds;
+  result.finish_seconds = summary.writeback_seconds + extract_seconds;
   result.solve_seconds = summary.solve_seconds;
   result.minimizer_seconds = summary.minimizer_seconds;
   result.iterations = summary.iterations;
@@ -258,10 +270,9 @@ SolveResult solveHandwritten(const PointScene& scene, const PointBundleAdjustmen
       problem.AddParameterBlock(point, 3);
       ordering->AddElementToGroup(point, 0);
     }
-    problem.AddResidualBlock(
-        new ReprojectionCost(new ReprojectionFunctor(scene.camera->intrinsics(), obs.pixel,
-                                                     ba.pixel_sigma)),
-        &huber, pose, point);
+    problem.AddResidualBlock(new ReprojectionCost(new ReprojectionFunctor(
+                                 scene.camera->intrinsics(), obs.pixel, ba.pixel_sigma)),
+                             &huber, pose, point);
   }
   problem.AddResidualBlock(
       new CameraDistanceCost(new CameraDistanceFunctor(scene.trueScaleDistance(), ba.scale_sigma)),
@@ -279,12 +290,14 @@ SolveResult solveHandwritten(const PointScene& scene, const PointBundleAdjustmen
   ceres::Solve(options, &problem, &summary);
   result.solve_seconds = secondsSince(solve_start);
 
+  const auto finish_start = Clock::now();
   for (std::size_t i = 0; i < num_cameras; ++i) {
     result.poses.push_back(Pose3::fromAmbient(&poses[7 * i]));
   }
   for (std::size_t p = 0; p < num_points; ++p) {
     result.points.push_back(Eigen::Vector3d::Map(&points[3 * p]));
   }
+  result.finish_seconds = secondsSince(finish_start);
   result.total_seconds = secondsSince(start);
   result.minimizer_seconds = summary.minimizer_time_in_seconds;
   result.iterations = std::max(0, static_cast<int>(summary.iterations.size()) - 1);
@@ -356,8 +369,8 @@ JacobianComparison compareJacobians(const EvaluationSet& analytic, const Evaluat
     comparison.max_relative_difference =
         std::max(comparison.max_relative_difference, difference / std::max(scale, 1e-300));
     for (int r = 0; r < 2; ++r) {
-      comparison.max_residual_difference = std::max(
-          comparison.max_residual_difference, std::abs(a.residual[r] - b.residual[r]));
+      comparison.max_residual_difference =
+          std::max(comparison.max_residual_difference, std::abs(a.residual[r] - b.residual[r]));
     }
   }
   return comparison;
@@ -419,9 +432,8 @@ int run(const BenchOptions& bench) {
   printPrecise("initial_cost_handwritten", handwritten.initial_cost);
   printPrecise("final_cost_graph", graph.final_cost);
   printPrecise("final_cost_handwritten", handwritten.final_cost);
-  print("final_cost_relative_difference",
-        std::abs(graph.final_cost - handwritten.final_cost) /
-            std::max(std::abs(handwritten.final_cost), 1e-300));
+  print("final_cost_relative_difference", std::abs(graph.final_cost - handwritten.final_cost) /
+                                              std::max(std::abs(handwritten.final_cost), 1e-300));
   const PointSceneErrors graph_errors = evaluatePointScene(scene, graph.poses, graph.points);
   const PointSceneErrors handwritten_errors =
       evaluatePointScene(scene, handwritten.poses, handwritten.points);
@@ -431,6 +443,8 @@ int run(const BenchOptions& bench) {
   print("seconds_total_handwritten", handwritten_total);
   print("seconds_build_graph", medianOf(graph_runs, &SolveResult::build_seconds));
   print("seconds_build_handwritten", medianOf(handwritten_runs, &SolveResult::build_seconds));
+  print("seconds_finish_graph", medianOf(graph_runs, &SolveResult::finish_seconds));
+  print("seconds_finish_handwritten", medianOf(handwritten_runs, &SolveResult::finish_seconds));
   print("seconds_solve_graph", medianOf(graph_runs, &SolveResult::solve_seconds));
   print("seconds_solve_handwritten", medianOf(handwritten_runs, &SolveResult::solve_seconds));
   print("seconds_minimizer_graph", medianOf(graph_runs, &SolveResult::minimizer_seconds));
@@ -472,8 +486,10 @@ int run(const BenchOptions& bench) {
   std::vector<double> analytic_ns;
   std::vector<double> autodiff_ns;
   for (int r = 0; r < bench.jacobian_runs; ++r) {
-    analytic_ns.push_back(nanosecondsPerEvaluation(analytic, bench.jacobian_run_seconds, &checksum));
-    autodiff_ns.push_back(nanosecondsPerEvaluation(autodiff, bench.jacobian_run_seconds, &checksum));
+    analytic_ns.push_back(
+        nanosecondsPerEvaluation(analytic, bench.jacobian_run_seconds, &checksum));
+    autodiff_ns.push_back(
+        nanosecondsPerEvaluation(autodiff, bench.jacobian_run_seconds, &checksum));
   }
   const double analytic_median = median(analytic_ns);
   const double autodiff_median = median(autodiff_ns);
@@ -495,8 +511,7 @@ int run(const BenchOptions& bench) {
 int main(int argc, char** argv) {
   curvesfm::BenchOptions bench;
   CLI::App app{"Factor-graph layer vs hand-written Ceres on one point bundle adjustment"};
-  app.add_option("--cameras", bench.scene.num_cameras, "Cameras on the arc")
-      ->capture_default_str();
+  app.add_option("--cameras", bench.scene.num_cameras, "Cameras on the arc")->capture_default_str();
   app.add_option("--points", bench.scene.num_points, "Points in the cube")->capture_default_str();
   app.add_option("--track-length", bench.scene.track_length,
                  "Consecutive cameras that observe each point")

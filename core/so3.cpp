@@ -36,7 +36,9 @@ Eigen::Matrix3d leftJacobian(const Eigen::Vector3d& w) {
   const Eigen::Matrix3d W = hat(w);
   if (theta < kSmallAngle) return Eigen::Matrix3d::Identity() + 0.5 * W + W * W / 6.0;
   const double t2 = theta * theta;
-  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(theta)) / t2 * W +
+  // (1 - cos) written as 2 sin^2(theta/2): no cancellation for small angles.
+  const double half_sin = std::sin(0.5 * theta);
+  return Eigen::Matrix3d::Identity() + 2.0 * half_sin * half_sin / t2 * W +
          (theta - std::sin(theta)) / (t2 * theta) * W * W;
 }
 

@@ -1,6 +1,7 @@
 #include "sim/point_scene.h"
 
 #include <cmath>
+#include <Eigen/Geometry>
 #include <random>
 
 #include "core/errors.h"
@@ -119,6 +120,16 @@ PointSceneErrors evaluatePointScene(const PointScene& scene,
         so3::log(cam_from_world[i].rotation() * truth.rotation().conjugate()).norm() / kDegToRad;
   }
   errors.position_rmse = std::sqrt(errors.position_rmse / num_cameras);
+  Eigen::Matrix3Xd estimated(3, num_cameras), truth(3, num_cameras);
+  for (std::size_t i = 0; i < num_cameras; ++i) {
+    estimated.col(i) = cam_from_world[i].inverseTranslation();
+    truth.col(i) = scene.true_cam_from_world[i].inverseTranslation();
+  }
+  const Eigen::Matrix4d truth_from_estimated = Eigen::umeyama(estimated, truth, true);
+  const Eigen::Matrix3Xd aligned =
+      (truth_from_estimated.topLeftCorner<3, 3>() * estimated).colwise() +
+      truth_from_estimated.topRightCorner<3, 1>();
+  errors.position_ate_sim3 = std::sqrt((aligned - truth).colwise().squaredNorm().mean());
   errors.rotation_mean_deg /= num_cameras;
   for (std::size_t p = 0; p < points.size(); ++p) {
     errors.point_rmse += (points[p] - scene.true_points[p]).squaredNorm();

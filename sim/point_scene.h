@@ -49,7 +49,10 @@ PointScene makePointScene(const PointSceneOptions& options);
 
 /// Errors of an estimate against the scene's ground truth (no alignment: the gauge is fixed).
 struct PointSceneErrors {
-  double position_rmse = 0.0;         ///< RMS camera-centre error (m).
+  double position_rmse = 0.0;         ///< RMS camera-centre error in the solver's gauge (m).
+  /// RMS camera-centre error after a Sim(3) (Umeyama) alignment to the truth (m): the ATE,
+  /// free of the drift that the gauge (camera 0 and one baseline) lets accumulate.
+  double position_ate_sim3 = 0.0;
   double rotation_mean_deg = 0.0;     ///< Mean camera rotation error (deg).
   double point_rmse = 0.0;            ///< RMS point error (m).
   double reprojection_rmse_px = 0.0;  ///< RMS of |project - observed| over all observations (px).

@@ -1,0 +1,76 @@
+#include "factors/pose_prior_factor.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/so3.h"
+#include "test/support/numerical_jacobian.h"
+
+namespace curvesfm {
+namespace {
+
+Pose3 randomPose(std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  return Pose3(so3::exp(Eigen::Vector3d(n(rng), n(rng), n(rng))),
+               Eigen::Vector3d(n(rng), n(rng), n(rng)));
+}
+
+TEST(PosePriorFactor, ZeroAtThePriorAndHandComputedOffset) {
+  const Pose3 prior(so3::exp(Eigen::Vector3d(0.1, 0.2, -0.3)), Eigen::Vector3d(1, 2, 3));
+  const PosePriorFactor factor(poseKey(0), prior, NoiseModel{});
+  Values values;
+  values.insert(poseKey(0), prior);
+  EXPECT_LT(factor.unwhitenedError(values).norm(), 1e-12);
+  Vector6d delta;
+  delta << 0.01, -0.02, 0.03, 0.5, -0.25, 0.125;
+  values.update(poseKey(0), prior.retract(delta));
+  EXPECT_LT((factor.unwhitenedError(values) - delta).norm(), 1e-12);
+}
+
+TEST(PosePriorFactor, JacobianMatchesNumerical) {
+  std::mt19937 rng(1);
+  for (int trial = 0; trial < 50; ++trial) {
+    const PosePriorFactor factor(poseKey(0), randomPose(rng), NoiseModel{});
+    Values values;
+    values.insert(poseKey(0), randomPose(rng));
+    testing::expectJacobiansMatchNumerical(factor, values, 1e-5);
+  }
+}
+
+TEST(CameraDistanceFactor, MeasuresDistanceBetweenCentres) {
+  // Centres at the origin and at (3, 4, 0): distance 5.
+  const Pose3 a;
+  const Pose3 b = Pose3(so3::exp(Eigen::Vector3d(0.2, 0.1, 0)), Eigen::Vector3d(3, 4, 0)).inverse();
+  Values values;
+  values.insert(poseKey(0), a);
+  values.insert(poseKey(1), b);
+  const CameraDistanceFactor factor(poseKey(0), poseKey(1), 4.5, NoiseModel{});
+  EXPECT_NEAR(factor.unwhitenedError(values)[0], 0.5, 1e-12);
+  EXPECT_THROW(CameraDistanceFactor(poseKey(0), poseKey(1), 0.0, NoiseModel{}), CheckError);
+}
+
+TEST(CameraDistanceFactor, JacobiansMatchNumerical) {
+  std::mt19937 rng(2);
+  for (int trial = 0; trial < 50; ++trial) {
+    const CameraDistanceFactor factor(poseKey(0), poseKey(1), 1.0, NoiseModel{});
+    Values values;
+    values.insert(poseKey(0), randomPose(rng));
+    values.insert(poseKey(1), randomPose(rng));
+    testing::expectJacobiansMatchNumerical(factor, values, 1e-5);
+  }
+}
+
+TEST(CameraDistanceFactor, CoincidentCentresGiveFiniteErrorAndZeroJacobians) {
+  Values values;
+  values.insert(poseKey(0), Pose3());
+  values.insert(poseKey(1), Pose3(so3::exp(Eigen::Vector3d(0.3, 0, 0)), Eigen::Vector3d::Zero()));
+  const Linearization linear =
+      CameraDistanceFactor(poseKey(0), poseKey(1), 2.0, NoiseModel{}).linearize(values);
+  EXPECT_DOUBLE_EQ(linear.error[0], -2.0);
+  EXPECT_TRUE(linear.jacobians[0].isZero());
+  EXPECT_TRUE(linear.jacobians[1].isZero());
+}
+
+}  // namespace
+}  // namespace curvesfm

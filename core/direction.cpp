@@ -41,7 +41,8 @@ Eigen::Vector2d Direction::localCoordinates(const Direction& other) const {
   const double sin_theta = orthogonal.norm();
   const double theta = std::atan2(sin_theta, v_.dot(w));
   // theta / sin(theta) -> 1 as theta -> 0.
-  const double scale = sin_theta < kSmallAngle ? 1.0 : theta / sin_theta;
+  // Switch on the angle, not on sin: near the antipode sin is tiny but theta / sin is not 1.
+  const double scale = theta < kSmallAngle ? 1.0 : theta / sin_theta;
   return basis().transpose() * (scale * orthogonal);
 }
 

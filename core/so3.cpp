@@ -27,7 +27,10 @@ Eigen::Vector3d log(const Eigen::Quaterniond& q_in) {
   const Eigen::Quaterniond q = q_in.w() < 0.0 ? Eigen::Quaterniond(-q_in.coeffs()) : q_in;
   const double sin_half = q.vec().norm();
   const double theta = 2.0 * std::atan2(sin_half, q.w());
-  const double k = sin_half < kSmallAngle ? 2.0 / q.w() : theta / sin_half;
+  // theta / sin(theta/2) from atan(s/w) ~ s/w - s^3/(3 w^3) when s is tiny.
+  const double k = sin_half < kSmallAngle
+                       ? 2.0 / q.w() - 2.0 * sin_half * sin_half / (3.0 * q.w() * q.w() * q.w())
+                       : theta / sin_half;
   return k * q.vec();
 }
 

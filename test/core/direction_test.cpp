@@ -220,7 +220,8 @@ TEST(Direction, AmbientRoundTrip) {
     double ambient[Direction::kAmbientDim];
     d.toAmbient(ambient);
     EXPECT_EQ(Eigen::Vector3d(ambient[0], ambient[1], ambient[2]), d.vector());
-    EXPECT_LE((Direction::fromAmbient(ambient).vector() - d.vector()).norm(), 1e-16);
+    // fromAmbient renormalises, which may move the last bit.
+    EXPECT_LE((Direction::fromAmbient(ambient).vector() - d.vector()).norm(), 1e-15);
   }
 }
 

@@ -12,6 +12,10 @@
 // its own problem building and copying results out. Then both cost functions are timed on
 // residual + ambient Jacobian evaluation alone, after checking that their Jacobians agree.
 //
+// A third, diagnostic solve builds the Ceres problem by hand with the graph's analytic cost
+// functions (FactorCostFunction) and no FactorGraph / Values / optimize(): against it,
+// graph_layer_overhead_ratio shows what the layer itself costs, apart from the Jacobian method.
+//
 // Output: `key: value` lines after one `#` header line. Times are medians over --repeats.
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/loss_function.h>
@@ -34,6 +38,7 @@
 #include "core/errors.h"
 #include "core/pose3.h"
 #include "factors/point_reprojection_factor.h"
+#include "factors/pose_prior_factor.h"
 #include "frontend/point_bundle_adjustment.h"
 #include "graph/ceres_cost_function.h"
 #include "graph/ceres_manifolds.h"
@@ -181,10 +186,16 @@ using CameraDistanceCost = ceres::AutoDiffCostFunction<CameraDistanceFunctor, 1,
 // --- the two solves --------------------------------------------------------------------------
 
 struct SolveResult {
-  double total_seconds = 0.0;   ///< Scene data in, optimised poses and points out.
-  double build_seconds = 0.0;   ///< Building the problem (graph: graph + Values + bridge).
-  double finish_seconds = 0.0;  ///< Results out (graph: write-back, final costs, extraction).
-  double solve_seconds = 0.0;   ///< ceres::Solve wall time.
+  double total_seconds = 0.0;  ///< Scene data in, optimised poses and points out.
+  double build_seconds = 0.0;  ///< Building the problem (graph: graph + Values + bridge).
+  double solve_seconds = 0.0;  ///< ceres::Solve wall time.
+  /// The rest of the total: results out (graph: write-back, final costs), freeing the problem.
+  double finish_seconds = 0.0;
+  // Graph only: buildPointBundleAdjustment(), optimize()'s setup (initial per-type costs,
+  // CeresProblem, ordering) and its write-back (Values update, final per-type costs).
+  double graph_construction_seconds = 0.0;
+  double bridge_setup_seconds = 0.0;
+  double writeback_seconds = 0.0;
   double minimizer_seconds = 0.0;
   int iterations = 0;
   double initial_cost = 0.0;
@@ -208,18 +219,22 @@ SolveResult solveWithGraph(const PointScene& scene, const PointBundleAdjustmentO
                            const OptimizerOptions& optimizer) {
   SolveResult result;
   const auto start = Clock::now();
-  PointBundleAdjustmentProblem problem = buildPointBundleAdjustment(baInput(scene), ba);
+  auto problem = std::make_unique<PointBundleAdjustmentProblem>(
+      buildPointBundleAdjustment(baInput(scene), ba));
   const double graph_seconds = secondsSince(start);
   const OptimizationSummary summary =
-      optimize(problem.graph, &problem.values, problem.config, optimizer);
-  const auto extract_start = Clock::now();
-  result.poses = extractPoses(problem.values, scene.initial_cam_from_world.size());
-  result.points = extractPoints(problem.values, scene.initial_points.size());
-  const double extract_seconds = secondsSince(extract_start);
+      optimize(problem->graph, &problem->values, problem->config, optimizer);
+  result.poses = extractPoses(problem->values, scene.initial_cam_from_world.size());
+  result.points = extractPoints(problem->values, scene.initial_points.size());
+  // Freeing the graph counts, as freeing the ceres::Problem does on the other side.
+  problem.reset();
   result.total_seconds = secondsSince(start);
   result.build_seconds = graph_seconds + summary.setup_seconds;
-  result.finish_seconds = summary.writeback_seconds + extract_seconds;
   result.solve_seconds = summary.solve_seconds;
+  result.finish_seconds = result.total_seconds - result.build_seconds - result.solve_seconds;
+  result.graph_construction_seconds = graph_seconds;
+  result.bridge_setup_seconds = summary.setup_seconds;
+  result.writeback_seconds = summary.writeback_seconds;
   result.minimizer_seconds = summary.minimizer_seconds;
   result.iterations = summary.iterations;
   result.initial_cost = summary.initial_cost;
@@ -228,8 +243,35 @@ SolveResult solveWithGraph(const PointScene& scene, const PointBundleAdjustmentO
   return result;
 }
 
+// Cost functions of a hand-built problem: the autodiff functors above (the baseline), or, as a
+// diagnostic that isolates the graph layer's own overhead, our analytic factors in
+// FactorCostFunction without FactorGraph, Values or optimize().
+enum class Differentiation { kAutodiff, kAnalytic };
+
+ceres::CostFunction* reprojectionCost(Differentiation kind, const PointScene& scene,
+                                      const PointObservation& obs,
+                                      const PointBundleAdjustmentOptions& ba) {
+  if (kind == Differentiation::kAutodiff) {
+    return new ReprojectionCost(
+        new ReprojectionFunctor(scene.camera->intrinsics(), obs.pixel, ba.pixel_sigma));
+  }
+  // The loss goes to Ceres separately (ceres::HuberLoss); the factor's kernel is not used here.
+  return new FactorCostFunction(std::make_shared<const PointReprojectionFactor>(
+      poseKey(obs.camera_index), pointKey(obs.point_index), obs.pixel, scene.camera,
+      NoiseModel{ba.pixel_sigma, {}}));
+}
+
+ceres::CostFunction* cameraDistanceCost(Differentiation kind, double distance,
+                                        const PointBundleAdjustmentOptions& ba) {
+  if (kind == Differentiation::kAutodiff) {
+    return new CameraDistanceCost(new CameraDistanceFunctor(distance, ba.scale_sigma));
+  }
+  return new FactorCostFunction(std::make_shared<const CameraDistanceFactor>(
+      poseKey(0), poseKey(1), distance, NoiseModel{ba.scale_sigma, {}}));
+}
+
 SolveResult solveHandwritten(const PointScene& scene, const PointBundleAdjustmentOptions& ba,
-                             const OptimizerOptions& optimizer) {
+                             const OptimizerOptions& optimizer, Differentiation kind) {
   SolveResult result;
   const auto start = Clock::now();
   const std::size_t num_cameras = scene.initial_cam_from_world.size();
@@ -246,7 +288,7 @@ SolveResult solveHandwritten(const PointScene& scene, const PointBundleAdjustmen
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
+  auto problem = std::make_unique<ceres::Problem>(problem_options);
   PoseManifold pose_manifold;
   ceres::HuberLoss huber(ba.kernel_width);
   auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
@@ -258,7 +300,7 @@ SolveResult solveHandwritten(const PointScene& scene, const PointBundleAdjustmen
     double* block = &poses[7 * i];
     if (pose_added[i]) return block;
     pose_added[i] = true;
-    problem.AddParameterBlock(block, 7, &pose_manifold);
+    problem->AddParameterBlock(block, 7, &pose_manifold);
     ordering->AddElementToGroup(block, 1);
     return block;
   };
@@ -267,17 +309,14 @@ SolveResult solveHandwritten(const PointScene& scene, const PointBundleAdjustmen
     double* point = &points[3 * obs.point_index];
     if (!point_added[obs.point_index]) {
       point_added[obs.point_index] = true;
-      problem.AddParameterBlock(point, 3);
+      problem->AddParameterBlock(point, 3);
       ordering->AddElementToGroup(point, 0);
     }
-    problem.AddResidualBlock(new ReprojectionCost(new ReprojectionFunctor(
-                                 scene.camera->intrinsics(), obs.pixel, ba.pixel_sigma)),
-                             &huber, pose, point);
+    problem->AddResidualBlock(reprojectionCost(kind, scene, obs, ba), &huber, pose, point);
   }
-  problem.AddResidualBlock(
-      new CameraDistanceCost(new CameraDistanceFunctor(scene.trueScaleDistance(), ba.scale_sigma)),
-      nullptr, addPose(0), addPose(1));
-  problem.SetParameterBlockConstant(&poses[0]);
+  problem->AddResidualBlock(cameraDistanceCost(kind, scene.trueScaleDistance(), ba), nullptr,
+                            addPose(0), addPose(1));
+  problem->SetParameterBlockConstant(&poses[0]);
 
   // The solver settings come from the same mapping the graph uses, so they cannot drift apart;
   // only the problem is hand-written.
@@ -287,18 +326,19 @@ SolveResult solveHandwritten(const PointScene& scene, const PointBundleAdjustmen
 
   const auto solve_start = Clock::now();
   ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
+  ceres::Solve(options, problem.get(), &summary);
   result.solve_seconds = secondsSince(solve_start);
 
-  const auto finish_start = Clock::now();
   for (std::size_t i = 0; i < num_cameras; ++i) {
     result.poses.push_back(Pose3::fromAmbient(&poses[7 * i]));
   }
   for (std::size_t p = 0; p < num_points; ++p) {
     result.points.push_back(Eigen::Vector3d::Map(&points[3 * p]));
   }
-  result.finish_seconds = secondsSince(finish_start);
+  // optimize() frees its bridge's ceres::Problem before it returns; do the same here.
+  problem.reset();
   result.total_seconds = secondsSince(start);
+  result.finish_seconds = result.total_seconds - result.build_seconds - result.solve_seconds;
   result.minimizer_seconds = summary.minimizer_time_in_seconds;
   result.iterations = std::max(0, static_cast<int>(summary.iterations.size()) - 1);
   result.initial_cost = summary.initial_cost;
@@ -408,9 +448,11 @@ int run(const BenchOptions& bench) {
   // Alternate the variants so that drifts in machine load hit both alike.
   std::vector<SolveResult> graph_runs;
   std::vector<SolveResult> handwritten_runs;
+  std::vector<SolveResult> direct_runs;
   for (int r = 0; r < bench.repeats; ++r) {
     graph_runs.push_back(solveWithGraph(scene, ba, optimizer));
-    handwritten_runs.push_back(solveHandwritten(scene, ba, optimizer));
+    handwritten_runs.push_back(solveHandwritten(scene, ba, optimizer, Differentiation::kAutodiff));
+    direct_runs.push_back(solveHandwritten(scene, ba, optimizer, Differentiation::kAnalytic));
   }
   auto medianOf = [](const std::vector<SolveResult>& runs, double SolveResult::*field) {
     std::vector<double> samples;
@@ -450,11 +492,28 @@ int run(const BenchOptions& bench) {
   print("seconds_minimizer_graph", medianOf(graph_runs, &SolveResult::minimizer_seconds));
   print("seconds_minimizer_handwritten",
         medianOf(handwritten_runs, &SolveResult::minimizer_seconds));
+  print("seconds_graph_construction",
+        medianOf(graph_runs, &SolveResult::graph_construction_seconds));
+  print("seconds_graph_bridge_setup", medianOf(graph_runs, &SolveResult::bridge_setup_seconds));
+  print("seconds_graph_writeback", medianOf(graph_runs, &SolveResult::writeback_seconds));
   const double graph_per_iteration = graph_total / graph_iterations;
   const double handwritten_per_iteration = handwritten_total / handwritten_iterations;
   print("seconds_per_iteration_graph", graph_per_iteration);
   print("seconds_per_iteration_handwritten", handwritten_per_iteration);
   print("graph_overhead_ratio", graph_per_iteration / handwritten_per_iteration);
+  // Diagnostic: the hand-built problem with the graph's analytic cost functions. Against it the
+  // ratio measures only what FactorGraph, Values and optimize() add, not the Jacobian method.
+  const SolveResult& direct = direct_runs.front();
+  const double direct_total = medianOf(direct_runs, &SolveResult::total_seconds);
+  const double direct_per_iteration = direct_total / std::max(direct.iterations, 1);
+  printInt("iterations_direct_analytic", direct.iterations);
+  printPrecise("final_cost_direct_analytic", direct.final_cost);
+  print("seconds_total_direct_analytic", direct_total);
+  print("seconds_build_direct_analytic", medianOf(direct_runs, &SolveResult::build_seconds));
+  print("seconds_solve_direct_analytic", medianOf(direct_runs, &SolveResult::solve_seconds));
+  print("seconds_finish_direct_analytic", medianOf(direct_runs, &SolveResult::finish_seconds));
+  print("seconds_per_iteration_direct_analytic", direct_per_iteration);
+  print("graph_layer_overhead_ratio", graph_per_iteration / direct_per_iteration);
   std::fflush(stdout);
 
   // Both cost function kinds at the starting values, one per observation. The graph lists the
@@ -481,6 +540,15 @@ int run(const BenchOptions& bench) {
     autodiff.parameters.push_back(parameters);
   }
   const JacobianComparison comparison = compareJacobians(analytic, autodiff);
+
+  // optimize() evaluates FactorGraph::costByType() twice (before and after) outside Ceres.
+  std::vector<double> cost_by_type_seconds;
+  for (int r = 0; r < bench.repeats; ++r) {
+    const auto start = Clock::now();
+    const auto costs = problem.graph.costByType(problem.values);
+    cost_by_type_seconds.push_back(secondsSince(start));
+  }
+  print("seconds_cost_by_type", median(cost_by_type_seconds));
 
   double checksum = 0.0;
   std::vector<double> analytic_ns;

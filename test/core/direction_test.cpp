@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test/support/numerical_jacobian.h"
+
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
@@ -13,27 +15,10 @@
 namespace curvesfm {
 namespace {
 
+using testing::numericalDerivative;
+using testing::randomUnitVector;
+
 constexpr double kPi = 3.14159265358979323846;
-
-// Central differences of f: R^2 -> R^3 at 0, one column per tangent coordinate.
-template <class F>
-Matrix32d numericalDerivative(F&& f, double step = 1e-6) {
-  Matrix32d jacobian;
-  for (int k = 0; k < 2; ++k) {
-    const Eigen::Vector2d delta = Eigen::Vector2d::Unit(k) * step;
-    jacobian.col(k) = (f(delta) - f(-delta)) / (2.0 * step);
-  }
-  return jacobian;
-}
-
-Eigen::Vector3d randomUnitVector(std::mt19937& rng) {
-  std::normal_distribution<double> normal(0.0, 1.0);
-  Eigen::Vector3d v;
-  do {
-    v = Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-  } while (v.norm() < 1e-3);
-  return v.normalized();
-}
 
 // Tangent vector with norm uniform in [0, max_norm].
 Eigen::Vector2d randomTangent(std::mt19937& rng, double max_norm) {
@@ -205,7 +190,7 @@ TEST(Direction, AngleToIsSymmetricAndMatchesAcos) {
 TEST(Direction, RetractDerivativeAtZeroIsBasis) {
   std::mt19937 rng(12);
   for (const Direction& d : testDirections(rng)) {
-    const Matrix32d numerical = numericalDerivative(
+    const Matrix32d numerical = numericalDerivative<2>(
         [&](const Eigen::Vector2d& delta) -> Eigen::Vector3d { return d.retract(delta).vector(); });
     EXPECT_LE((numerical - d.basis()).cwiseAbs().maxCoeff(), 1e-6)
         << "v = " << d.vector().transpose() << "\nnumerical:\n"

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test/support/numerical_jacobian.h"
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -11,27 +13,10 @@
 namespace curvesfm {
 namespace {
 
+using testing::numericalDerivative;
+using testing::randomUnitVector;
+
 constexpr double kPi = 3.14159265358979323846;
-
-// Central differences of f: R^3 -> R^3 at 0, one column per coordinate.
-template <class F>
-Eigen::Matrix3d numericalDerivative(F&& f, double step = 1e-6) {
-  Eigen::Matrix3d jacobian;
-  for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector3d delta = Eigen::Vector3d::Unit(k) * step;
-    jacobian.col(k) = (f(delta) - f(-delta)) / (2.0 * step);
-  }
-  return jacobian;
-}
-
-Eigen::Vector3d randomUnitVector(std::mt19937& rng) {
-  std::normal_distribution<double> normal(0.0, 1.0);
-  Eigen::Vector3d v;
-  do {
-    v = Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-  } while (v.norm() < 1e-3);
-  return v.normalized();
-}
 
 // Rotation vector with angle drawn uniformly from [min_angle, max_angle].
 Eigen::Vector3d randomRotationVector(std::mt19937& rng, double min_angle, double max_angle) {
@@ -168,7 +153,7 @@ TEST(So3, LeftJacobianMatchesCentralDifferences) {
   std::mt19937 rng(8);
   for (const Eigen::Vector3d& w : representativeRotationVectors(rng)) {
     const Eigen::Quaterniond exp_w_inv = so3::exp(w).conjugate();
-    const Eigen::Matrix3d numerical = numericalDerivative(
+    const Eigen::Matrix3d numerical = numericalDerivative<3>(
         [&](const Eigen::Vector3d& dw) { return so3::log(so3::exp(w + dw) * exp_w_inv); });
     EXPECT_LE((so3::leftJacobian(w) - numerical).cwiseAbs().maxCoeff(), 1e-6)
         << "w = " << w.transpose() << ", angle = " << w.norm() << "\nanalytic:\n"
@@ -219,7 +204,7 @@ TEST(So3, LeftJacobianInverseMatchesCentralDifferences) {
     // A step across pi would make log wrap to the other side.
     if (w.norm() > kPi - 1e-3) continue;
     const Eigen::Quaterniond exp_w = so3::exp(w);
-    const Eigen::Matrix3d numerical = numericalDerivative(
+    const Eigen::Matrix3d numerical = numericalDerivative<3>(
         [&](const Eigen::Vector3d& d) { return so3::log(so3::exp(d) * exp_w); });
     const double scale = std::max(1.0, numerical.cwiseAbs().maxCoeff());
     EXPECT_LE((so3::leftJacobianInverse(w) - numerical).cwiseAbs().maxCoeff(), 1e-6 * scale)
@@ -234,7 +219,7 @@ TEST(So3, RightJacobianInverseMatchesCentralDifferences) {
     // A step across pi would make log wrap to the other side.
     if (w.norm() > kPi - 1e-3) continue;
     const Eigen::Quaterniond exp_w = so3::exp(w);
-    const Eigen::Matrix3d numerical = numericalDerivative(
+    const Eigen::Matrix3d numerical = numericalDerivative<3>(
         [&](const Eigen::Vector3d& d) { return so3::log(exp_w * so3::exp(d)); });
     const double scale = std::max(1.0, numerical.cwiseAbs().maxCoeff());
     EXPECT_LE((so3::rightJacobianInverse(w) - numerical).cwiseAbs().maxCoeff(), 1e-6 * scale)

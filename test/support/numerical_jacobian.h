@@ -5,11 +5,33 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <random>
 
 #include "graph/factor.h"
 #include "graph/values.h"
 
 namespace curvesfm::testing {
+
+/// Central differences at 0 of f: R^kIn -> R^3, one column per input coordinate.
+template <int kIn, class F>
+Eigen::Matrix<double, 3, kIn> numericalDerivative(F&& f, double step = 1e-6) {
+  Eigen::Matrix<double, 3, kIn> jacobian;
+  for (int k = 0; k < kIn; ++k) {
+    const Eigen::Matrix<double, kIn, 1> delta = Eigen::Matrix<double, kIn, 1>::Unit(k) * step;
+    jacobian.col(k) = (f(delta) - f(-delta)) / (2.0 * step);
+  }
+  return jacobian;
+}
+
+/// A uniformly random unit vector.
+inline Eigen::Vector3d randomUnitVector(std::mt19937& rng) {
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::Vector3d v;
+  do {
+    v = Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+  } while (v.norm() < 1e-3);
+  return v.normalized();
+}
 
 /// d error / d delta at delta = 0, where the key's value is retract(value, delta).
 inline Eigen::MatrixXd numericalJacobian(const Factor& factor, const Values& values, Key key,

@@ -1,6 +1,6 @@
 // graph_overhead_bench: what the factor-graph layer costs on top of plain Ceres.
 //
-// One synthetic point bundle adjustment (sim/point_scene.h) is solved twice in one process:
+// One synthetic point bundle adjustment (sim/point_scene.h) is solved two ways in one process:
 //   graph:        buildPointBundleAdjustment() + optimize() + extractPoses/Points(), i.e. the
 //                 path the curvesfm point-ba command takes, with analytic factor Jacobians lifted
 //                 to the ambient blocks by FactorCostFunction;
@@ -183,7 +183,7 @@ struct CameraDistanceFunctor {
 using ReprojectionCost = ceres::AutoDiffCostFunction<ReprojectionFunctor, 2, 7, 3>;
 using CameraDistanceCost = ceres::AutoDiffCostFunction<CameraDistanceFunctor, 1, 7, 7>;
 
-// --- the two solves --------------------------------------------------------------------------
+// --- the solves ------------------------------------------------------------------------------
 
 struct SolveResult {
   double total_seconds = 0.0;  ///< Scene data in, optimised poses and points out.
@@ -585,13 +585,13 @@ int main(int argc, char** argv) {
                  "Consecutive cameras that observe each point")
       ->capture_default_str();
   app.add_option("--repeats", bench.repeats, "Solves per variant (median reported)")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   app.add_option("--threads", bench.threads, "Ceres threads")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1, 256))
       ->capture_default_str();
   app.add_option("--max-iterations", bench.max_iterations, "Ceres outer iterations")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(0, 100000))
       ->capture_default_str();
   try {
     app.parse(argc, argv);

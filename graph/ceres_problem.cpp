@@ -6,7 +6,7 @@ namespace curvesfm {
 
 CeresProblem::CeresProblem(const FactorGraph& graph, const Values& values,
                            const ProblemConfig& config)
-    : config_(config) {
+    : graph_(graph), config_(config) {
   // Parameter blocks must not move once Ceres holds pointers: size the storage first.
   std::size_t total = 0;
   std::unordered_map<Key, VariableType> used;
@@ -30,31 +30,30 @@ CeresProblem::CeresProblem(const FactorGraph& graph, const Values& values,
   for (const auto& factor : graph) {
     blocks.clear();
     for (Key key : factor->keys()) {
-      if (!offsets_.count(key)) addVariable(key, used.at(key), values, config);
-      blocks.push_back(storage_.data() + offsets_.at(key));
+      const auto it = offsets_.find(key);
+      blocks.push_back(it != offsets_.end() ? storage_.data() + it->second
+                                            : addVariable(key, used.at(key), values));
     }
     problem_->AddResidualBlock(new FactorCostFunction(factor),
                                const_cast<ceres::LossFunction*>(lossFor(factor->noiseModel().kernel)),
                                blocks);
-    factor_keys_.push_back(factor->keys());
   }
 }
 
-void CeresProblem::addVariable(Key key, VariableType type, const Values& values,
-                               const ProblemConfig& config) {
+double* CeresProblem::addVariable(Key key, VariableType type, const Values& values) {
   const std::size_t offset = storage_.size();
   storage_.resize(offset + ambientDim(type));
   values.toAmbient(key, storage_.data() + offset);
   offsets_.emplace(key, offset);
   keys_.push_back(key);
-  types_.push_back(type);
   double* block = storage_.data() + offset;
   problem_->AddParameterBlock(block, ambientDim(type),
                               const_cast<ceres::Manifold*>(manifoldFor(type)));
-  if (config.isConstant(key)) {
+  if (config_.isConstant(key)) {
     problem_->SetParameterBlockConstant(block);
     ++num_constant_;
   }
+  return block;
 }
 
 const ceres::LossFunction* CeresProblem::lossFor(const RobustKernel& kernel) {
@@ -82,10 +81,10 @@ std::shared_ptr<ceres::ParameterBlockOrdering> CeresProblem::structureFirstOrder
   auto isFreeStructure = [this](Key key) {
     return categoryOf(key) != VariableCategory::kPose && !config_.isConstant(key);
   };
-  for (const auto& keys : factor_keys_) {
+  for (const auto& factor : graph_) {
     Key first_structure;
     bool seen = false;
-    for (Key key : keys) {
+    for (Key key : factor->keys()) {
       if (!isFreeStructure(key)) continue;
       if (seen && key != first_structure) {
         *why_not = "factor couples " + first_structure.toString() + " and " + key.toString();

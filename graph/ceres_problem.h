@@ -43,16 +43,16 @@ class CeresProblem {
   std::shared_ptr<ceres::ParameterBlockOrdering> structureFirstOrdering(std::string* why_not) const;
 
  private:
-  void addVariable(Key key, VariableType type, const Values& values, const ProblemConfig& config);
+  /// Adds the parameter block of `key` (initialised from `values`) and returns it.
+  double* addVariable(Key key, VariableType type, const Values& values);
   const ceres::LossFunction* lossFor(const RobustKernel& kernel);
 
+  FactorGraph graph_;  // shares the factors; structureFirstOrdering() reads their keys
   std::unique_ptr<ceres::Problem> problem_;
   std::vector<Key> keys_;
   std::unordered_map<Key, std::size_t> offsets_;
-  std::vector<VariableType> types_;
   std::vector<double> storage_;
   std::vector<std::unique_ptr<RobustLoss>> losses_;
-  std::vector<std::vector<Key>> factor_keys_;
   int num_constant_ = 0;
   ProblemConfig config_;
 };

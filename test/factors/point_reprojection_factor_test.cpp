@@ -8,6 +8,7 @@
 #include "core/so3.h"
 #include "graph/ceres_cost_function.h"
 #include "graph/ceres_manifolds.h"
+#include "test/support/ceres_checks.h"
 #include "test/support/numerical_jacobian.h"
 
 namespace curvesfm {
@@ -78,22 +79,8 @@ TEST(PointReprojectionFactor, CeresAdapterPassesGradientChecker) {
   numeric_options.ridders_relative_initial_step_size = 1e-3;
   ceres::GradientChecker checker(&cost, &manifolds, numeric_options);
   for (int trial = 0; trial < 20; ++trial) {
-    const Values values = randomConfiguration(rng);
-    double pose[7], point[3];
-    values.toAmbient(poseKey(0), pose);
-    values.toAmbient(pointKey(0), point);
-    const double* blocks[] = {pose, point};
-    ceres::GradientChecker::ProbeResults results;
-    checker.Probe(blocks, 1e-7, &results);
-    ASSERT_TRUE(results.return_value);
-    for (int i = 0; i < 2; ++i) {
-      const double scale = std::max(1.0, results.local_numeric_jacobians[i].cwiseAbs().maxCoeff());
-      EXPECT_LT((results.local_jacobians[i] - results.local_numeric_jacobians[i])
-                    .cwiseAbs()
-                    .maxCoeff(),
-                1e-6 * scale)
-          << results.error_log;
-    }
+    testing::expectProbeAgrees(
+        checker, testing::AmbientBlocks(*factor, randomConfiguration(rng)), 1e-6);
   }
 }
 

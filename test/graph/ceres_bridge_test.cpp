@@ -9,6 +9,7 @@
 #include "graph/ceres_problem.h"
 #include "graph/optimizer.h"
 #include "test/graph/test_factors.h"
+#include "test/support/ceres_checks.h"
 #include "test/support/numerical_jacobian.h"
 
 namespace curvesfm {
@@ -51,29 +52,7 @@ TEST(FactorCostFunction, PassesCeresGradientChecker) {
   ceres::NumericDiffOptions numeric_options;
   ceres::GradientChecker checker(&cost, &manifolds, numeric_options);
   for (int trial = 0; trial < 20; ++trial) {
-    const Values values = randomValues(rng);
-    std::vector<std::vector<double>> blocks;
-    std::vector<const double*> pointers;
-    for (Key key : factor->keys()) {
-      blocks.emplace_back(ambientDim(values.type(key)));
-      values.toAmbient(key, blocks.back().data());
-    }
-    for (const auto& block : blocks) pointers.push_back(block.data());
-    // Probe's own verdict is purely relative, so it flags the structural zeros of [R p]x
-    // (1e-17 against 1e-14); compare its Jacobians with a mixed tolerance instead.
-    ceres::GradientChecker::ProbeResults results;
-    checker.Probe(pointers.data(), 1e-7, &results);
-    ASSERT_TRUE(results.return_value);
-    for (std::size_t i = 0; i < blocks.size(); ++i) {
-      const auto& user = results.local_jacobians[i];
-      const auto& numeric = results.local_numeric_jacobians[i];
-      EXPECT_LT((user - numeric).cwiseAbs().maxCoeff(),
-                1e-7 * std::max(1.0, numeric.cwiseAbs().maxCoeff()))
-          << "block " << i << "\n" << results.error_log;
-      EXPECT_LT((results.jacobians[i] - results.numeric_jacobians[i]).cwiseAbs().maxCoeff(),
-                1e-7 * std::max(1.0, results.numeric_jacobians[i].cwiseAbs().maxCoeff()))
-          << "ambient block " << i;
-    }
+    testing::expectProbeAgrees(checker, testing::AmbientBlocks(*factor, randomValues(rng)), 1e-7);
   }
 }
 
@@ -82,15 +61,9 @@ TEST(FactorCostFunction, WhitensResidualsBySigma) {
   const Values values = randomValues(rng);
   const auto factor = allTypesFactor(NoiseModel{0.25, {}});
   FactorCostFunction cost(factor);
-  std::vector<std::vector<double>> blocks;
-  std::vector<const double*> pointers;
-  for (Key key : factor->keys()) {
-    blocks.emplace_back(ambientDim(values.type(key)));
-    values.toAmbient(key, blocks.back().data());
-  }
-  for (const auto& block : blocks) pointers.push_back(block.data());
+  const testing::AmbientBlocks blocks(*factor, values);
   Eigen::Vector3d residual;
-  ASSERT_TRUE(cost.Evaluate(pointers.data(), residual.data(), nullptr));
+  ASSERT_TRUE(cost.Evaluate(blocks.pointers.data(), residual.data(), nullptr));
   EXPECT_TRUE(residual.isApprox(factor->unwhitenedError(values) / 0.25));
 }
 

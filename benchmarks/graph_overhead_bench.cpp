@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "benchmarks/support/bench_common.h"
 #include "core/camera.h"
 #include "core/errors.h"
 #include "core/pose3.h"
@@ -49,17 +50,13 @@
 namespace curvesfm {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> samples) {
-  std::sort(samples.begin(), samples.end());
-  const std::size_t n = samples.size();
-  return n % 2 == 1 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
-}
+using bench::Clock;
+using bench::median;
+using bench::print;
+using bench::printInt;
+using bench::printPrecise;
+using bench::printText;
+using bench::secondsSince;
 
 struct BenchOptions {
   PointSceneOptions scene;  ///< Scene size via --cameras, --points, --track-length.
@@ -418,12 +415,6 @@ JacobianComparison compareJacobians(const EvaluationSet& analytic, const Evaluat
 
 // --- output ----------------------------------------------------------------------------------
 
-void print(const char* key, double value) { std::printf("%s: %.6g\n", key, value); }
-void printPrecise(const char* key, double value) { std::printf("%s: %.12g\n", key, value); }
-void printInt(const char* key, long long value) { std::printf("%s: %lld\n", key, value); }
-void printText(const char* key, const std::string& value) {
-  std::printf("%s: %s\n", key, value.c_str());
-}
 
 int run(const BenchOptions& bench) {
   const PointScene scene = makePointScene(bench.scene);
@@ -593,18 +584,5 @@ int main(int argc, char** argv) {
   app.add_option("--max-iterations", bench.max_iterations, "Ceres outer iterations")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
-  try {
-    return curvesfm::run(bench);
-  } catch (const curvesfm::InvalidOptions& e) {
-    std::cerr << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 1;
-  }
+  return curvesfm::bench::parseAndRun(app, argc, argv, [&] { return curvesfm::run(bench); });
 }

@@ -4,8 +4,8 @@
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "frontend/scale_gauge.h"
 #include "factors/point_reprojection_factor.h"
-#include "factors/pose_prior_factor.h"
 
 namespace curvesfm {
 
@@ -49,14 +49,8 @@ PointBundleAdjustmentProblem buildPointBundleAdjustment(
 
   if (options.fix_first_pose && num_cameras > 0) problem.config.setConstant(poseKey(0));
   if (options.fix_scale) {
-    CURVESFM_CHECK(num_cameras >= 2) << "fixing the scale needs two cameras";
-    const double distance = input.scale_distance > 0.0
-                                ? input.scale_distance
-                                : (input.cam_from_world[1].inverseTranslation() -
-                                   input.cam_from_world[0].inverseTranslation())
-                                      .norm();
-    problem.graph.emplace<CameraDistanceFactor>(poseKey(0), poseKey(1), distance,
-                                                NoiseModel{options.scale_sigma, {}});
+    addScaleGauge(input.cam_from_world, input.scale_distance, options.scale_sigma,
+                  &problem.graph);
   }
   return problem;
 }

@@ -22,9 +22,9 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values,
   const auto start = std::chrono::steady_clock::now();
   OptimizationSummary summary;
   summary.num_factors = static_cast<int>(graph.size());
-  summary.initial_cost_by_type = graph.costByType(*values);
 
   CeresProblem bridge(graph, *values, config);
+  summary.initial_cost_by_type = bridge.costByType();
   ceres::Solver::Options ceres_options = toCeresOptions(options);
   summary.ordering = "automatic";
   if (options.structure_first_ordering) {
@@ -44,7 +44,7 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values,
 
   const auto writeback_start = std::chrono::steady_clock::now();
   bridge.writeBack(values);
-  summary.final_cost_by_type = graph.costByType(*values);
+  summary.final_cost_by_type = bridge.costByType();
   summary.writeback_seconds = secondsSince(writeback_start);
 
   summary.initial_cost = ceres_summary.initial_cost;

@@ -1,5 +1,7 @@
 #include "graph/ceres_problem.h"
 
+#include <algorithm>
+
 #include "graph/ceres_manifolds.h"
 
 namespace curvesfm {
@@ -9,9 +11,11 @@ CeresProblem::CeresProblem(const FactorGraph& graph, const Values& values,
     : graph_(graph), config_(config) {
   // Parameter blocks must not move once Ceres holds pointers: size the storage first.
   std::size_t total = 0;
+  std::size_t num_factor_keys = 0;
   std::unordered_map<Key, VariableType> used;
   for (const auto& factor : graph) {
     const std::vector<VariableType> expected = factor->variableTypes();
+    num_factor_keys += factor->keys().size();
     for (std::size_t i = 0; i < factor->keys().size(); ++i) {
       const Key key = factor->keys()[i];
       const VariableType stored = values.type(key);
@@ -26,6 +30,8 @@ CeresProblem::CeresProblem(const FactorGraph& graph, const Values& values,
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_ = std::make_unique<ceres::Problem>(problem_options);
 
+  factor_types_.reserve(graph.size());
+  factor_blocks_.reserve(num_factor_keys);
   std::vector<double*> blocks;
   for (const auto& factor : graph) {
     blocks.clear();
@@ -37,7 +43,20 @@ CeresProblem::CeresProblem(const FactorGraph& graph, const Values& values,
     problem_->AddResidualBlock(new FactorCostFunction(factor),
                                const_cast<ceres::LossFunction*>(lossFor(factor->noiseModel().kernel)),
                                blocks);
+    factor_types_.push_back(typeIndex(factor->typeName()));
+    factor_blocks_.insert(factor_blocks_.end(), blocks.begin(), blocks.end());
+    max_residual_dimension_ = std::max(max_residual_dimension_, factor->residualDimension());
+    max_factor_keys_ = std::max(max_factor_keys_, factor->keys().size());
   }
+}
+
+int CeresProblem::typeIndex(const char* name) {
+  // A graph has a handful of factor types: a linear scan beats hashing the name.
+  for (std::size_t i = 0; i < type_names_.size(); ++i) {
+    if (type_names_[i] == name) return static_cast<int>(i);
+  }
+  type_names_.emplace_back(name);
+  return static_cast<int>(type_names_.size()) - 1;
 }
 
 double* CeresProblem::addVariable(Key key, VariableType type, const Values& values) {
@@ -74,6 +93,28 @@ double* CeresProblem::block(Key key) {
 
 void CeresProblem::writeBack(Values* values) const {
   for (const Key key : keys_) values->setFromAmbient(key, storage_.data() + offsets_.at(key));
+}
+
+std::map<std::string, FactorTypeCost> CeresProblem::costByType() const {
+  // Ceres' EvaluateResidualBlock would do, but it re-applies every manifold's PlusJacobian and
+  // may allocate scratch per block; the factors themselves need neither.
+  std::vector<FactorTypeCost> by_index(type_names_.size());
+  std::vector<double> error(max_residual_dimension_);
+  const std::vector<double*> no_jacobians(max_factor_keys_, nullptr);
+  const double* const* blocks = factor_blocks_.data();
+  for (std::size_t i = 0; i < graph_.size(); ++i) {
+    const Factor& factor = *graph_[i];
+    factor.evaluateRaw(blocks, error.data(), no_jacobians.data());
+    blocks += factor.keys().size();
+    const double squared_norm =
+        Eigen::Map<const Eigen::VectorXd>(error.data(), factor.residualDimension()).squaredNorm();
+    FactorTypeCost& entry = by_index[factor_types_[i]];
+    ++entry.count;
+    entry.cost += factor.noiseModel().cost(squared_norm);
+  }
+  std::map<std::string, FactorTypeCost> by_type;
+  for (std::size_t t = 0; t < type_names_.size(); ++t) by_type.emplace(type_names_[t], by_index[t]);
+  return by_type;
 }
 
 std::shared_ptr<ceres::ParameterBlockOrdering> CeresProblem::structureFirstOrdering(

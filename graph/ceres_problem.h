@@ -4,6 +4,7 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include <map>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -37,6 +38,12 @@ class CeresProblem {
   /// Copies every parameter block back into `values`.
   void writeBack(Values* values) const;
 
+  /// Cost per Factor::typeName() at the current parameter blocks (after a Solve, the solution),
+  /// with FactorGraph::costByType's meaning and arithmetic (NoiseModel::cost of each factor's
+  /// error), but read straight from the blocks with no per-factor allocation, so optimize() can
+  /// afford it before and after every solve.
+  std::map<std::string, FactorTypeCost> costByType() const;
+
   /// Schur ordering with every free non-pose variable in group 0 and the poses in group 1.
   /// Returns nullptr and sets `why_not` if two free non-pose variables share a factor, since
   /// the eliminated group must be an independent set.
@@ -46,13 +53,22 @@ class CeresProblem {
   /// Adds the parameter block of `key` (initialised from `values`) and returns it.
   double* addVariable(Key key, VariableType type, const Values& values);
   const ceres::LossFunction* lossFor(const RobustKernel& kernel);
+  /// Index of `name` in type_names_, added if new.
+  int typeIndex(const char* name);
 
-  FactorGraph graph_;  // shares the factors; structureFirstOrdering() reads their keys
+  FactorGraph graph_;  // shares the factors; structureFirstOrdering() and costByType() read them
   std::unique_ptr<ceres::Problem> problem_;
   std::vector<Key> keys_;
   std::unordered_map<Key, std::size_t> offsets_;
   std::vector<double> storage_;
   std::vector<std::unique_ptr<RobustLoss>> losses_;
+  // Per factor, in graph order: the index of its type name, and its parameter blocks (one run
+  // of factor->keys().size() pointers per factor).
+  std::vector<int> factor_types_;
+  std::vector<const double*> factor_blocks_;
+  int max_residual_dimension_ = 0;
+  std::size_t max_factor_keys_ = 0;
+  std::vector<std::string> type_names_;
   int num_constant_ = 0;
   ProblemConfig config_;
 };

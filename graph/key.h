@@ -65,6 +65,21 @@ inline Key startLengthKey(std::uint32_t c, std::uint32_t i) { return Key('a', c,
 /// Length d2 of segment i of curve c (arm of the second inner control point).
 inline Key endLengthKey(std::uint32_t c, std::uint32_t i) { return Key('b', c, i); }
 
+/// The keys of the variables of segment i of curve c, which runs from Q_i to Q_{i+1}.
+struct SegmentKeys {
+  Key q0;  ///< Start point Q_i.
+  Key q1;  ///< End point Q_{i+1} (shared with segment i + 1).
+  Key v0;  ///< Tangent v_i at the start.
+  Key v1;  ///< Tangent v_{i+1} at the end (shared with segment i + 1).
+  Key d1;  ///< Start arm length d1_i.
+  Key d2;  ///< End arm length d2_i.
+};
+
+inline SegmentKeys segmentKeys(std::uint32_t c, std::uint32_t i) {
+  return {curvePointKey(c, i), curvePointKey(c, i + 1), directionKey(c, i),
+          directionKey(c, i + 1), startLengthKey(c, i),  endLengthKey(c, i)};
+}
+
 }  // namespace curvesfm
 
 template <>

@@ -6,6 +6,7 @@
 
 #include "core/errors.h"
 #include "core/so3.h"
+#include "sim/trajectory_errors.h"
 
 namespace curvesfm {
 namespace {
@@ -110,27 +111,11 @@ double PointScene::trueScaleDistance() const {
 PointSceneErrors evaluatePointScene(const PointScene& scene,
                                     const std::vector<Pose3>& cam_from_world,
                                     const std::vector<Eigen::Vector3d>& points) {
+  const TrajectoryErrors trajectory = evaluateTrajectory(scene.true_cam_from_world, cam_from_world);
   PointSceneErrors errors;
-  const std::size_t num_cameras = scene.true_cam_from_world.size();
-  for (std::size_t i = 0; i < num_cameras; ++i) {
-    const Pose3& truth = scene.true_cam_from_world[i];
-    errors.position_rmse +=
-        (cam_from_world[i].inverseTranslation() - truth.inverseTranslation()).squaredNorm();
-    errors.rotation_mean_deg +=
-        so3::log(cam_from_world[i].rotation() * truth.rotation().conjugate()).norm() / kDegToRad;
-  }
-  errors.position_rmse = std::sqrt(errors.position_rmse / num_cameras);
-  Eigen::Matrix3Xd estimated(3, num_cameras), truth(3, num_cameras);
-  for (std::size_t i = 0; i < num_cameras; ++i) {
-    estimated.col(i) = cam_from_world[i].inverseTranslation();
-    truth.col(i) = scene.true_cam_from_world[i].inverseTranslation();
-  }
-  const Eigen::Matrix4d truth_from_estimated = Eigen::umeyama(estimated, truth, true);
-  const Eigen::Matrix3Xd aligned =
-      (truth_from_estimated.topLeftCorner<3, 3>() * estimated).colwise() +
-      truth_from_estimated.topRightCorner<3, 1>();
-  errors.position_ate_sim3 = std::sqrt((aligned - truth).colwise().squaredNorm().mean());
-  errors.rotation_mean_deg /= num_cameras;
+  errors.position_rmse = trajectory.position_rmse;
+  errors.position_ate_sim3 = trajectory.position_ate_sim3;
+  errors.rotation_mean_deg = trajectory.rotation_mean_deg;
   for (std::size_t p = 0; p < points.size(); ++p) {
     errors.point_rmse += (points[p] - scene.true_points[p]).squaredNorm();
   }

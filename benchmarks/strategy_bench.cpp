@@ -1,0 +1,426 @@
+// strategy_bench: solver strategies, linear solvers, robust kernels and regulariser weights of
+// curve bundle adjustment, compared on a fixed set of synthetic curve scenes.
+//
+// Every combination of strategy {joint, alternating, inner_iterations} x linear solver
+// {sparse_schur, dense_schur, iterative_schur} x kernel {none, huber, cauchy} x (lambda1,
+// lambda2) in {0, 1e2, 1e4} x {0, 1, 10} runs on each scene from the same perturbed start.
+// Then the best configuration (lowest mean ATE over the scenes) runs again with integer edge
+// positions instead of sub-pixel ones.
+//
+// Writes into --out: runs.csv (one row per run), summary.md (tables), and PNG plots:
+// error_vs_time.png, curve_error_vs_time.png, error_vs_weights.png, error_by_kernel.png.
+// Prints a `key: value` summary. Errors: ATE after Sim(3) alignment (mm), mean rotation error
+// (deg), curve error = mean distance of sampled curve points to the true curve after the same
+// alignment (mm).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <cmath>
+#include <algorithm>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "benchmarks/support/bench_common.h"
+#include "benchmarks/support/plot.h"
+#include "core/errors.h"
+#include "frontend/curve_bundle_adjustment.h"
+#include "graph/scheduler.h"
+#include "sim/curve_scene.h"
+
+namespace curvesfm {
+namespace {
+
+struct NamedScene {
+  std::string name;
+  CurveSceneOptions options;
+};
+
+// Orbit without noise; forward walk with image noise and clutter; orbit with occlusions.
+std::vector<NamedScene> benchScenes(bool quick) {
+  std::vector<NamedScene> scenes;
+  NamedScene orbit{"orbit_clean", {}};
+  orbit.options.seed = 1;
+  scenes.push_back(orbit);
+  NamedScene walk{"walk_noisy", {}};
+  walk.options.camera_path = CameraPath::kForwardWalk;
+  walk.options.pixel_noise = 6.0;
+  walk.options.num_clutter_edges = 15;
+  walk.options.seed = 2;
+  scenes.push_back(walk);
+  NamedScene occluded{"orbit_occluded", {}};
+  occluded.options.occlusion_fraction = 0.3;
+  occluded.options.pixel_noise = 3.0;
+  occluded.options.seed = 3;
+  scenes.push_back(occluded);
+  if (quick) scenes.resize(1);
+  return scenes;
+}
+
+struct Config {
+  Strategy strategy = Strategy::kJoint;
+  LinearSolver solver = LinearSolver::kSparseSchur;
+  RobustKernelType kernel = RobustKernelType::kHuber;
+  double lambda1 = 100.0;
+  double lambda2 = 1.0;
+  bool subpixel = true;
+
+  std::string key() const {
+    std::ostringstream out;
+    out << toString(strategy) << "/" << toString(solver) << "/" << toString(kernel) << "/"
+        << lambda1 << "/" << lambda2 << "/" << (subpixel ? "subpixel" : "integer");
+    return out.str();
+  }
+};
+
+struct Run {
+  std::string scene;
+  Config config;
+  CurveSceneErrors before;
+  CurveSceneErrors after;
+  int iterations = 0;
+  double seconds = 0.0;
+  double final_cost = 0.0;
+  bool converged = false;
+};
+
+// A scene with its nearest-edge fields, built once and solved many times.
+struct PreparedScene {
+  std::string name;
+  CurveScene scene;
+  CurveBundleAdjustmentInput input;
+};
+
+PreparedScene prepare(const NamedScene& named) {
+  PreparedScene prepared{named.name, makeCurveScene(named.options), {}};
+  const CurveScene& scene = prepared.scene;
+  CurveBundleAdjustmentInput& input = prepared.input;
+  input.camera = scene.camera;
+  input.cam_from_world = scene.initial_cam_from_world;
+  input.curves = scene.initial_curves;
+  input.scale_distance = scene.trueScaleDistance();
+  for (const CurveKeyframe& keyframe : scene.keyframes) {
+    input.fields.push_back(std::make_shared<const NearestEdgeField>(
+        NearestEdgeField::build(keyframe.edges, keyframe.grad_x, keyframe.grad_y)));
+  }
+  for (const CurveObservation& obs : scene.observations) {
+    input.observations.push_back({obs.curve_index, obs.segment_index, obs.keyframe_index});
+  }
+  return prepared;
+}
+
+Run solve(const PreparedScene& prepared, const Config& config, int max_iterations) {
+  CurveBundleAdjustmentOptions ba;
+  ba.kernel = config.kernel;
+  ba.lambda1 = config.lambda1;
+  ba.lambda2 = config.lambda2;
+  ba.use_subpixel_edges = config.subpixel;
+  SchedulerOptions scheduler;
+  scheduler.strategy = config.strategy;
+  scheduler.optimizer.linear_solver = config.solver;
+  scheduler.optimizer.max_iterations = max_iterations;
+
+  const auto start = bench::Clock::now();
+  CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(prepared.input, ba);
+  const ScheduleReport report =
+      runSchedule(problem.graph, &problem.values, problem.config, scheduler);
+  Run run;
+  run.seconds = bench::secondsSince(start);
+  run.scene = prepared.name;
+  run.config = config;
+  std::vector<Pose3> poses;
+  for (std::size_t j = 0; j < prepared.input.cam_from_world.size(); ++j) {
+    poses.push_back(problem.values.at<Pose3>(poseKey(j)));
+  }
+  run.before = evaluateCurveScene(prepared.scene, prepared.input.cam_from_world,
+                                  prepared.input.curves);
+  run.after = evaluateCurveScene(prepared.scene, poses,
+                                 extractCurves(problem.values, prepared.input.curves));
+  run.iterations = report.total_iterations;
+  run.final_cost = report.final_cost;
+  run.converged = report.converged;
+  return run;
+}
+
+std::vector<Config> sweepConfigs() {
+  std::vector<Config> configs;
+  for (Strategy strategy :
+       {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
+    for (LinearSolver solver :
+         {LinearSolver::kSparseSchur, LinearSolver::kDenseSchur, LinearSolver::kIterativeSchur}) {
+      for (RobustKernelType kernel :
+           {RobustKernelType::kNone, RobustKernelType::kHuber, RobustKernelType::kCauchy}) {
+        for (double lambda1 : {0.0, 1e2, 1e4}) {
+          for (double lambda2 : {0.0, 1.0, 10.0}) {
+            configs.push_back({strategy, solver, kernel, lambda1, lambda2, true});
+          }
+        }
+      }
+    }
+  }
+  return configs;
+}
+
+// Means over the scenes of one configuration.
+struct Aggregate {
+  Config config;
+  int runs = 0;
+  double ate_mm = 0.0;
+  double rotation_deg = 0.0;
+  double curve_mm = 0.0;
+  double seconds = 0.0;
+  double iterations = 0.0;
+};
+
+std::vector<Aggregate> aggregate(const std::vector<Run>& runs) {
+  std::map<std::string, Aggregate> by_key;
+  std::vector<std::string> order;
+  for (const Run& run : runs) {
+    auto [it, inserted] = by_key.try_emplace(run.config.key());
+    if (inserted) order.push_back(run.config.key());
+    Aggregate& a = it->second;
+    a.config = run.config;
+    ++a.runs;
+    a.ate_mm += 1e3 * run.after.position_ate_sim3;
+    a.rotation_deg += run.after.rotation_mean_deg;
+    a.curve_mm += 1e3 * run.after.curve_mean_error_aligned;
+    a.seconds += run.seconds;
+    a.iterations += run.iterations;
+  }
+  std::vector<Aggregate> result;
+  for (const std::string& key : order) {
+    Aggregate a = by_key[key];
+    a.ate_mm /= a.runs;
+    a.rotation_deg /= a.runs;
+    a.curve_mm /= a.runs;
+    a.seconds /= a.runs;
+    a.iterations /= a.runs;
+    result.push_back(a);
+  }
+  return result;
+}
+
+void writeCsv(const std::vector<Run>& runs, const std::filesystem::path& path) {
+  std::ofstream out(path);
+  if (!out) throw IoError(path.string(), "cannot open for writing");
+  out << "scene,strategy,linear_solver,kernel,lambda1,lambda2,edges,ate_before_mm,ate_after_mm,"
+         "rotation_before_deg,rotation_after_deg,curve_before_mm,curve_after_mm,iterations,"
+         "seconds,final_cost,converged\n";
+  for (const Run& r : runs) {
+    out << r.scene << "," << toString(r.config.strategy) << "," << toString(r.config.solver)
+        << "," << toString(r.config.kernel) << "," << r.config.lambda1 << ","
+        << r.config.lambda2 << "," << (r.config.subpixel ? "subpixel" : "integer") << ","
+        << 1e3 * r.before.position_ate_sim3 << "," << 1e3 * r.after.position_ate_sim3 << ","
+        << r.before.rotation_mean_deg << "," << r.after.rotation_mean_deg << ","
+        << 1e3 * r.before.curve_mean_error_aligned << ","
+        << 1e3 * r.after.curve_mean_error_aligned << "," << r.iterations << "," << r.seconds
+        << "," << r.final_cost << "," << (r.converged ? 1 : 0) << "\n";
+  }
+}
+
+std::string row(const Aggregate& a) {
+  char line[256];
+  std::snprintf(line, sizeof(line), "| %s | %s | %s | %g | %g | %.2f | %.3f | %.2f | %.1f | %.3f |",
+                toString(a.config.strategy).c_str(), toString(a.config.solver).c_str(),
+                toString(a.config.kernel).c_str(), a.config.lambda1, a.config.lambda2, a.ate_mm,
+                a.rotation_deg, a.curve_mm, a.iterations, a.seconds);
+  return line;
+}
+
+constexpr const char* kTableHeader =
+    "| strategy | linear solver | kernel | lambda1 | lambda2 | ATE (mm) | rotation (deg) | "
+    "curve (mm) | iterations | time (s) |\n|---|---|---|---|---|---|---|---|---|---|\n";
+
+void writeSummary(const std::vector<Aggregate>& sweep, const std::vector<Run>& edge_runs,
+                  const std::vector<NamedScene>& scenes, const std::filesystem::path& path) {
+  std::ofstream out(path);
+  if (!out) throw IoError(path.string(), "cannot open for writing");
+  out << "# Curve bundle adjustment: strategy bench\n\nScenes:";
+  for (const NamedScene& scene : scenes) out << " " << scene.name;
+  out << ". Values are means over the scenes, after BA from the perturbed start.\n\n";
+  std::vector<Aggregate> sorted = sweep;
+  std::sort(sorted.begin(), sorted.end(),
+            [](const Aggregate& a, const Aggregate& b) { return a.ate_mm < b.ate_mm; });
+  out << "## All configurations, best ATE first\n\n" << kTableHeader;
+  for (const Aggregate& a : sorted) out << row(a) << "\n";
+  out << "\n## Integer vs sub-pixel edges (best configuration)\n\n" << kTableHeader;
+  for (const Aggregate& a : aggregate(edge_runs)) {
+    out << row(a) << (a.config.subpixel ? " sub-pixel" : " integer") << "\n";
+  }
+}
+
+std::vector<Aggregate> filter(const std::vector<Aggregate>& all,
+                              const std::function<bool(const Config&)>& keep) {
+  std::vector<Aggregate> kept;
+  for (const Aggregate& a : all) {
+    if (keep(a.config)) kept.push_back(a);
+  }
+  return kept;
+}
+
+void plotErrorVsTime(const std::vector<Run>& runs, bool curve, const std::filesystem::path& path) {
+  PlotOptions options;
+  options.title = curve ? "Curve error vs time, every run" : "Pose error vs time, every run";
+  options.x_label = "solve time (s)";
+  options.y_label = curve ? "curve error after BA (mm)" : "ATE after BA (mm)";
+  options.log_x = true;
+  options.log_y = true;
+  Plot plot(options);
+  for (Strategy strategy :
+       {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
+    PlotSeries series;
+    series.label = toString(strategy);
+    series.style = PlotSeries::Style::kMarkers;
+    series.marker_size = 6.0;
+    for (const Run& run : runs) {
+      if (run.config.strategy != strategy) continue;
+      series.x.push_back(run.seconds);
+      series.y.push_back(1e3 * (curve ? run.after.curve_mean_error_aligned
+                                      : run.after.position_ate_sim3));
+    }
+    plot.add(series);
+  }
+  plot.save(path.string());
+}
+
+void plotWeights(const std::vector<Aggregate>& sweep, const std::filesystem::path& path) {
+  // Joint, sparse Schur, Huber: one bar per lambda2 over lambda1 groups.
+  const auto base = filter(sweep, [](const Config& c) {
+    return c.strategy == Strategy::kJoint && c.solver == LinearSolver::kSparseSchur &&
+           c.kernel == RobustKernelType::kHuber;
+  });
+  BarChartOptions options;
+  options.title = "Curve error vs weights (joint, sparse Schur, Huber)";
+  options.x_label = "lambda1 (segment length)";
+  options.y_label = "curve error after BA (mm)";
+  options.value_labels = true;
+  BarChart chart({"lambda1 = 0", "lambda1 = 1e2", "lambda1 = 1e4"}, options);
+  for (double lambda2 : {0.0, 1.0, 10.0}) {
+    BarSeries series;
+    series.label = "lambda2 = " + std::to_string(static_cast<int>(lambda2));
+    for (double lambda1 : {0.0, 1e2, 1e4}) {
+      double value = std::nan("");
+      for (const Aggregate& a : base) {
+        if (a.config.lambda1 == lambda1 && a.config.lambda2 == lambda2) value = a.curve_mm;
+      }
+      series.values.push_back(value);
+    }
+    chart.add(series);
+  }
+  chart.save(path.string());
+}
+
+void plotKernels(const std::vector<Aggregate>& sweep, const std::filesystem::path& path) {
+  BarChartOptions options;
+  options.title = "Pose error by kernel and strategy (sparse Schur, default weights)";
+  options.x_label = "robust kernel";
+  options.y_label = "ATE after BA (mm)";
+  options.value_labels = true;
+  BarChart chart({"none", "huber", "cauchy"}, options);
+  for (Strategy strategy :
+       {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
+    BarSeries series;
+    series.label = toString(strategy);
+    for (RobustKernelType kernel :
+         {RobustKernelType::kNone, RobustKernelType::kHuber, RobustKernelType::kCauchy}) {
+      double value = std::nan("");
+      for (const Aggregate& a : sweep) {
+        const Config& c = a.config;
+        if (c.strategy == strategy && c.kernel == kernel &&
+            c.solver == LinearSolver::kSparseSchur && c.lambda1 == 1e2 && c.lambda2 == 1.0) {
+          value = a.ate_mm;
+        }
+      }
+      series.values.push_back(value);
+    }
+    chart.add(series);
+  }
+  chart.save(path.string());
+}
+
+struct BenchOptions {
+  std::string out = "bench_out/strategy";  ///< Output folder (created).
+  bool quick = false;                      ///< One scene and a reduced sweep (smoke test).
+  int max_iterations = 100;                ///< Ceres iterations per solve.
+};
+
+int run(const BenchOptions& options) {
+  const auto start = bench::Clock::now();
+  const std::filesystem::path out(options.out);
+  std::filesystem::create_directories(out);
+  const std::vector<NamedScene> named = benchScenes(options.quick);
+  std::vector<PreparedScene> scenes;
+  for (const NamedScene& scene : named) scenes.push_back(prepare(scene));
+
+  std::vector<Config> configs = sweepConfigs();
+  if (options.quick) configs.resize(configs.size() / 9);
+  std::vector<Run> runs;
+  int done = 0;
+  const int total = static_cast<int>(configs.size() * scenes.size());
+  for (const Config& config : configs) {
+    for (const PreparedScene& scene : scenes) {
+      runs.push_back(solve(scene, config, options.max_iterations));
+      if (++done % 20 == 0 || done == total) {
+        std::fprintf(stderr, "\r%d / %d runs, %.0f s", done, total,
+                     bench::secondsSince(start));
+      }
+    }
+  }
+  std::fprintf(stderr, "\n");
+  const std::vector<Aggregate> sweep = aggregate(runs);
+  const Aggregate best = *std::min_element(
+      sweep.begin(), sweep.end(),
+      [](const Aggregate& a, const Aggregate& b) { return a.ate_mm < b.ate_mm; });
+
+  std::vector<Run> edge_runs;
+  for (bool subpixel : {false, true}) {
+    Config config = best.config;
+    config.subpixel = subpixel;
+    for (const PreparedScene& scene : scenes) {
+      edge_runs.push_back(solve(scene, config, options.max_iterations));
+    }
+  }
+
+  writeCsv(runs, out / "runs.csv");
+  writeSummary(sweep, edge_runs, named, out / "summary.md");
+  plotErrorVsTime(runs, false, out / "error_vs_time.png");
+  plotErrorVsTime(runs, true, out / "curve_error_vs_time.png");
+  plotWeights(sweep, out / "error_vs_weights.png");
+  plotKernels(sweep, out / "error_by_kernel.png");
+
+  std::printf("# strategy_bench: %d runs on %zu scenes\n", total, scenes.size());
+  double ate_before = 0.0;
+  for (const Run& run : runs) ate_before += 1e3 * run.before.position_ate_sim3;
+  bench::print("ate_before_mm_mean", ate_before / runs.size());
+  bench::printText("best_config", best.config.key());
+  bench::print("best_ate_mm", best.ate_mm);
+  bench::print("best_rotation_deg", best.rotation_deg);
+  bench::print("best_curve_mm", best.curve_mm);
+  for (const Aggregate& a : aggregate(edge_runs)) {
+    const std::string prefix = a.config.subpixel ? "subpixel_" : "integer_";
+    bench::print((prefix + "ate_mm").c_str(), a.ate_mm);
+    bench::print((prefix + "curve_mm").c_str(), a.curve_mm);
+  }
+  bench::print("total_seconds", bench::secondsSince(start));
+  bench::printText("outputs", (out / "{runs.csv,summary.md,*.png}").string());
+  return 0;
+}
+
+}  // namespace
+}  // namespace curvesfm
+
+int main(int argc, char** argv) {
+  curvesfm::BenchOptions options;
+  CLI::App app{"Curve BA strategies x linear solvers x kernels x weights on synthetic scenes"};
+  app.add_option("--out", options.out, "Output folder for CSV, table and plots")
+      ->capture_default_str();
+  app.add_flag("--quick", options.quick, "One scene and a ninth of the sweep (smoke test)");
+  app.add_option("--max-iterations", options.max_iterations, "Ceres iterations per solve")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  return curvesfm::bench::parseAndRun(app, argc, argv, [&] { return curvesfm::run(options); });
+}

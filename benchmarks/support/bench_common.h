@@ -1,0 +1,60 @@
+#pragma once
+
+// Small helpers shared by the benchmark harnesses: wall-clock timing, medians and the
+// `key: value` output lines that docs/benchmarks.md quotes.
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "core/errors.h"
+
+namespace curvesfm::bench {
+
+using Clock = std::chrono::steady_clock;
+
+inline double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Median of `samples` (mean of the middle two for an even count); 0 for none.
+inline double median(std::vector<double> samples) {
+  if (samples.empty()) return 0.0;
+  std::sort(samples.begin(), samples.end());
+  const std::size_t n = samples.size();
+  return n % 2 == 1 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
+}
+
+inline void print(const char* key, double value) { std::printf("%s: %.6g\n", key, value); }
+inline void printPrecise(const char* key, double value) { std::printf("%s: %.12g\n", key, value); }
+inline void printInt(const char* key, long long value) { std::printf("%s: %lld\n", key, value); }
+inline void printText(const char* key, const std::string& value) {
+  std::printf("%s: %s\n", key, value.c_str());
+}
+
+/// Parses the command line of `app`, then runs `run`. Exit codes as the curvesfm binary: 2 for
+/// usage errors and invalid options, 1 for any other error (one line on stderr), else run's.
+template <class Run>
+int parseAndRun(CLI::App& app, int argc, char** argv, Run&& run) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  try {
+    return run();
+  } catch (const InvalidOptions& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace curvesfm::bench

@@ -1,0 +1,19 @@
+#include "frontend/scale_gauge.h"
+
+#include "core/check.h"
+#include "factors/pose_prior_factor.h"
+
+namespace curvesfm {
+
+void addScaleGauge(const std::vector<Pose3>& cam_from_world, double distance, double sigma,
+                   FactorGraph* graph) {
+  CURVESFM_CHECK(cam_from_world.size() >= 2) << "fixing the scale needs two poses";
+  const double fixed =
+      distance > 0.0
+          ? distance
+          : (cam_from_world[1].inverseTranslation() - cam_from_world[0].inverseTranslation())
+                .norm();
+  graph->emplace<CameraDistanceFactor>(poseKey(0), poseKey(1), fixed, NoiseModel{sigma, {}});
+}
+
+}  // namespace curvesfm

@@ -1,0 +1,112 @@
+#include "frontend/curve_bundle_adjustment.h"
+
+#include <gtest/gtest.h>
+
+#include "graph/scheduler.h"
+#include "sim/curve_scene.h"
+
+namespace curvesfm {
+namespace {
+
+CurveBundleAdjustmentInput startingGuess(const CurveScene& scene) {
+  CurveBundleAdjustmentInput input;
+  input.camera = scene.camera;
+  input.cam_from_world = scene.initial_cam_from_world;
+  input.curves = scene.initial_curves;
+  input.scale_distance = scene.trueScaleDistance();
+  for (const CurveKeyframe& keyframe : scene.keyframes) {
+    input.fields.push_back(std::make_shared<const NearestEdgeField>(
+        NearestEdgeField::build(keyframe.edges, keyframe.grad_x, keyframe.grad_y)));
+  }
+  for (const CurveObservation& obs : scene.observations) {
+    input.observations.push_back({obs.curve_index, obs.segment_index, obs.keyframe_index});
+  }
+  return input;
+}
+
+struct Solved {
+  CurveSceneErrors before;
+  CurveSceneErrors after;
+  ScheduleReport report;
+};
+
+Solved solve(const CurveScene& scene, Strategy strategy,
+             const CurveBundleAdjustmentOptions& ba = {}) {
+  const CurveBundleAdjustmentInput input = startingGuess(scene);
+  CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
+  SchedulerOptions scheduler;
+  scheduler.strategy = strategy;
+  scheduler.optimizer.max_iterations = 100;
+  Solved solved;
+  solved.before = evaluateCurveScene(scene, input.cam_from_world, input.curves);
+  solved.report = runSchedule(problem.graph, &problem.values, problem.config, scheduler);
+  std::vector<Pose3> poses;
+  for (std::size_t j = 0; j < input.cam_from_world.size(); ++j) {
+    poses.push_back(problem.values.at<Pose3>(poseKey(j)));
+  }
+  solved.after = evaluateCurveScene(scene, poses, extractCurves(problem.values, input.curves));
+  return solved;
+}
+
+// The issue's protocol: poses perturbed by ~2 cm / 1 deg, curves by ~2 cm, noise-free images.
+CurveSceneOptions perturbedScene() { return CurveSceneOptions{}; }
+
+TEST(CurveBundleAdjustment, JointRecoversPosesAndCurvesFromAPerturbedStart) {
+  const Solved solved = solve(makeCurveScene(perturbedScene()), Strategy::kJoint);
+  // Measured (seed 42): ATE 30 -> 2.8 mm, rotation 1.71 -> 0.065 deg, aligned curve error
+  // 27.5 -> 10.0 mm with the parabola sub-pixel fit; ATE 4.6 mm with the Gaussian fit now in
+  // NearestEdgeField. The result is sensitive to such details (docs/benchmarks.md, "Curve bundle
+  // adjustment"), hence the loose bounds. The curve figure is the weak one: a straight line can
+  // slide along itself, which the edge residual does not see.
+  EXPECT_LT(solved.after.position_ate_sim3, 0.25 * solved.before.position_ate_sim3);
+  EXPECT_LT(solved.after.rotation_mean_deg, 0.1 * solved.before.rotation_mean_deg);
+  EXPECT_LT(solved.after.curve_mean_error_aligned, 0.5 * solved.before.curve_mean_error_aligned);
+  EXPECT_LT(solved.report.final_cost, 0.1 * solved.report.initial_cost);
+}
+
+TEST(CurveBundleAdjustment, AlternatingReachesTheCostOfJointAndImprovesAsMuch) {
+  const CurveScene scene = makeCurveScene(perturbedScene());
+  const Solved joint = solve(scene, Strategy::kJoint);
+  const Solved alternating = solve(scene, Strategy::kAlternating);
+  // Both are local minima of the same objective; alternating's is not worse. Measured: cost
+  // 17663 -> 813 (joint), -> 78 (alternating); its poses stall in the flat valley of a global
+  // rotation about the fixed keyframe (rotation error 0.23 deg vs joint's 0.065 deg).
+  EXPECT_LE(alternating.report.final_cost, 1.05 * joint.report.final_cost);
+  EXPECT_LT(alternating.after.position_ate_sim3, 0.3 * alternating.before.position_ate_sim3);
+  EXPECT_LT(alternating.after.rotation_mean_deg, 0.2 * alternating.before.rotation_mean_deg);
+  EXPECT_LT(alternating.after.curve_mean_error_aligned,
+            0.5 * alternating.before.curve_mean_error_aligned);
+  // Each round may only lower the cost.
+  double previous = alternating.report.initial_cost;
+  for (const ScheduleRound& round : alternating.report.rounds) {
+    if (round.skipped) continue;
+    EXPECT_LE(round.summary.final_cost, previous * (1 + 1e-9)) << round.phase << round.round;
+    previous = round.summary.final_cost;
+  }
+}
+
+TEST(CurveBundleAdjustment, PartlyHiddenCurvesStayNearTheTruth) {
+  // Start at the truth with a contiguous 30-50% of a curve hidden in half of the (curve,
+  // keyframe) pairs: hidden samples may slide or be capped, but must not drag the curves far.
+  // Measured: aligned curve error 6.9 mm, ATE 4.7 mm, against 1.4 mm / 1.1 mm with nothing
+  // hidden. So a bias remains; its cause is not traced yet (a candidate: on curved edges, hidden
+  // samples within the reach of the visible end measure along a gradient that is not normal to
+  // them). Issue 3's note tracks it.
+  CurveSceneOptions options;
+  options.pose_noise_translation = 0.0;
+  options.pose_noise_rotation_deg = 0.0;
+  options.curve_point_noise = 0.0;
+  options.curve_tangent_noise_deg = 0.0;
+  options.curve_length_noise = 0.0;
+  options.occlusion_fraction = 0.5;
+  const CurveScene scene = makeCurveScene(options);
+  int partly_hidden = 0;
+  for (const CurveObservation& obs : scene.observations) partly_hidden += obs.partlyHidden();
+  ASSERT_GT(partly_hidden, static_cast<int>(scene.observations.size()) / 8);
+  const Solved solved = solve(scene, Strategy::kJoint);
+  EXPECT_LT(solved.after.position_ate_sim3, 0.007);
+  EXPECT_LT(solved.after.curve_mean_error_aligned, 0.01);
+}
+
+}  // namespace
+}  // namespace curvesfm

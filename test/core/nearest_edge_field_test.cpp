@@ -98,7 +98,8 @@ int countMismatches(const NearestEdgeField& field, const cv::Mat& edges, int rea
 TEST(NearestEdgeField, ExactOnRandomEdgeMaps) {
   for (const cv::Size size : {cv::Size(37, 23), cv::Size(160, 120)}) {
     for (const double density : {0.005, 0.2}) {
-      for (const int reach : {1, 3, 15}) {
+      // 1 to 15: every block by the window search (with AVX2); 25: window and envelope mixed.
+      for (const int reach : {1, 3, 15, 25}) {
         for (const unsigned seed : {1u, 2u, 3u}) {
           std::mt19937 rng(seed);
           const cv::Mat edges = randomEdges(size, density, rng);
@@ -189,6 +190,17 @@ TEST(NearestEdgeField, ExactOnThinImagesAndHugeReach) {
       const NearestEdgeField field = buildWithRandomGradients(edges, reach);
       EXPECT_EQ(countMismatches(field, edges, reach), 0) << size << " R " << reach;
     }
+  }
+}
+
+// Beyond 32767 columns the row pass switches to 64-bit arithmetic; R > 127 disables the window
+// search, R = 40 mixes it with the envelope.
+TEST(NearestEdgeField, ExactOnVeryWideImages) {
+  std::mt19937 rng(13);
+  const cv::Mat edges = randomEdges(cv::Size(33000, 2), 0.002, rng);
+  for (const int reach : {15, 40, 200}) {
+    const NearestEdgeField field = buildWithRandomGradients(edges, reach);
+    EXPECT_EQ(countMismatches(field, edges, reach), 0) << "R " << reach;
   }
 }
 

@@ -15,6 +15,15 @@ namespace {
 // distance exceeds any reach, small enough that r +- kFarRow never overflows.
 constexpr std::int32_t kFarRow = 1 << 29;
 
+// The hot loops are compiled twice where the compiler can dispatch at run time (GCC/Clang on
+// x86-64 ELF): the build's baseline is SSE2, and AVX2 (twice the lanes, blend and gather
+// instructions) makes the whole build about twice as fast on sparse edge maps.
+#if defined(__x86_64__) && defined(__ELF__) && (defined(__GNUC__) || defined(__clang__))
+#define CURVESFM_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define CURVESFM_AVX2_CLONES
+#endif
+
 // ln(value) for value >= 0 to about 1e-6 relative, a few times cheaper than std::log: the
 // exponent plus the atanh series of the mantissa folded into [sqrt(1/2), sqrt(2)). Zero gives
 // about -88 (finite), which keeps the sub-pixel fit free of infinities.
@@ -85,11 +94,11 @@ float inverseSqrt(float value) {
 // The fit of RowFitter, on arrays that do not overlap (hence __restrict). Branch-free (selects,
 // divisors kept away from zero without a comparison) and in two loops (one loop gets its
 // selects threaded into branches by the compiler), so that both vectorise.
+CURVESFM_AVX2_CLONES
 void fitProfiles(int count, const float* __restrict gx, const float* __restrict gy,
                  const float* __restrict step_x, const float* __restrict step_y,
                  const float* __restrict before, const float* __restrict after,
-                 float* __restrict normal_x, float* __restrict normal_y,
-                 float* __restrict offset) {
+                 float* __restrict normal_x, float* __restrict normal_y, float* __restrict offset) {
   for (int i = 0; i < count; ++i) {  // The vertex, in steps.
     const float log_before = fastLog(before[i]);
     const float log_center = fastLog(gx[i] * gx[i] + gy[i] * gy[i]);
@@ -126,22 +135,36 @@ template <class T>
 class RowFitter {
  public:
   explicit RowFitter(int width)
-      : column_(width), gx_(width), gy_(width), step_x_(width), step_y_(width),
-        before_(width), after_(width), normal_x_(width), normal_y_(width), offset_(width) {}
+      : column_(width),
+        gx_(width),
+        gy_(width),
+        step_x_(width),
+        step_y_(width),
+        before_(width),
+        after_(width),
+        normal_x_(width),
+        normal_y_(width),
+        offset_(width) {}
 
-  // Appends the edge pixels of one row (non-zero in `mask`) to `out`, left to right.
-  void fitRow(const std::uint8_t* mask, const GradientRows<T>& rows, int row, int width,
-              int height, std::vector<EdgePixel>* out) {
+  // Appends the edge pixels of one row (non-zero in `mask`) to `out`, left to right, and their
+  // columns to `columns`.
+  void fitRow(const std::uint8_t* mask, const GradientRows<T>& rows, int row, int width, int height,
+              std::vector<EdgePixel>* out, std::vector<std::int32_t>* columns) {
     const int count = findEdges(mask, width);
+    columns->insert(columns->end(), column_.begin(), column_.begin() + count);
     gather(rows, count, row > 0 && row < height - 1, width);
     fitProfiles(count, gx_.data(), gy_.data(), step_x_.data(), step_y_.data(), before_.data(),
                 after_.data(), normal_x_.data(), normal_y_.data(), offset_.data());
+    const std::size_t first = out->size();
+    out->resize(first + static_cast<std::size_t>(count));  // Within the reserved capacity.
+    EdgePixel* edges = out->data() + first;
     for (int i = 0; i < count; ++i) {
-      EdgePixel edge;
-      edge.pixel = Eigen::Vector2f(static_cast<float>(column_[i]), static_cast<float>(row));
-      edge.normal = Eigen::Vector2f(normal_x_[i], normal_y_[i]);
-      edge.subpixel = edge.pixel + offset_[i] * edge.normal;
-      out->push_back(edge);
+      const float x = static_cast<float>(column_[i]);
+      const float y = static_cast<float>(row);
+      edges[i].pixel = Eigen::Vector2f(x, y);
+      edges[i].normal = Eigen::Vector2f(normal_x_[i], normal_y_[i]);
+      edges[i].subpixel =
+          Eigen::Vector2f(x + offset_[i] * normal_x_[i], y + offset_[i] * normal_y_[i]);
     }
   }
 
@@ -195,8 +218,8 @@ class RowFitter {
       float before = squared;  // Flat where a neighbour is outside the image.
       float after = squared;
       const bool interior = interior_row && column > 0 && column < width - 1;
-      if (interior || (rows.contains(-step_y, column - step_x) &&
-                       rows.contains(step_y, column + step_x))) {
+      if (interior ||
+          (rows.contains(-step_y, column - step_x) && rows.contains(step_y, column + step_x))) {
         before = rows.squaredMagnitude(-step_y, column - step_x);
         after = rows.squaredMagnitude(step_y, column + step_x);
       }
@@ -221,20 +244,47 @@ class RowFitter {
   std::vector<float> offset_;  // Sub-pixel shift along the normal (px).
 };
 
-// Appends the edge pixels in row-major order; row_start[r] is the index of the first edge pixel
-// in row r (row_start has height + 1 entries).
+// Asks for a row of memory ahead of use. The fit reads the gradients around scattered edge
+// pixels, a pattern the hardware prefetchers miss; without this, large images spend about a
+// sixth of the build waiting for gradient rows.
+void prefetchRow(const std::uint8_t* row, std::size_t bytes) {
+#if defined(__GNUC__) || defined(__clang__)
+  for (std::size_t offset = 0; offset < bytes; offset += 64) __builtin_prefetch(row + offset);
+#else
+  static_cast<void>(row);
+  static_cast<void>(bytes);
+#endif
+}
+
+// Where the edge pixels are, for the distance transform: row_start[r] is the index of the first
+// edge pixel in row r (height + 1 entries), column[e] the column of edge pixel e.
+struct EdgeLayout {
+  std::vector<std::int32_t> row_start;
+  std::vector<std::int32_t> column;
+};
+
+// Appends the edge pixels to `out` in row-major order and returns their layout.
 template <class T>
-void collectEdges(const cv::Mat& edges, const cv::Mat& grad_x, const cv::Mat& grad_y,
-                  std::vector<EdgePixel>* out, std::vector<std::int32_t>* row_start) {
-  out->reserve(static_cast<std::size_t>(cv::countNonZero(edges)));
-  row_start->assign(static_cast<std::size_t>(edges.rows) + 1, 0);
+EdgeLayout collectEdges(const cv::Mat& edges, const cv::Mat& grad_x, const cv::Mat& grad_y,
+                        std::vector<EdgePixel>* out) {
+  const std::size_t count = static_cast<std::size_t>(cv::countNonZero(edges));
+  out->reserve(count);
+  EdgeLayout layout;
+  layout.row_start.assign(static_cast<std::size_t>(edges.rows) + 1, 0);
+  layout.column.reserve(count);
   RowFitter<T> fitter(edges.cols);
+  constexpr int kPrefetchRows = 2;
   for (int row = 0; row < edges.rows; ++row) {
-    (*row_start)[row] = static_cast<std::int32_t>(out->size());
+    if (row + kPrefetchRows < edges.rows) {
+      prefetchRow(grad_x.ptr(row + kPrefetchRows), grad_x.cols * sizeof(T));
+      prefetchRow(grad_y.ptr(row + kPrefetchRows), grad_y.cols * sizeof(T));
+    }
+    layout.row_start[row] = static_cast<std::int32_t>(out->size());
     fitter.fitRow(edges.ptr<std::uint8_t>(row), GradientRows<T>(grad_x, grad_y, row), row,
-                  edges.cols, edges.rows, out);
+                  edges.cols, edges.rows, out, &layout.column);
   }
-  (*row_start)[edges.rows] = static_cast<std::int32_t>(out->size());
+  layout.row_start[edges.rows] = static_cast<std::int32_t>(out->size());
+  return layout;
 }
 
 // `index` if `within`, else -1, without a branch: pixels within and beyond R interleave
@@ -246,34 +296,48 @@ std::int32_t indexWithinReach(std::int32_t index, bool within) {
 // Columns per block of the window search (see DistanceSweep).
 constexpr int kWindowBlock = 64;
 
-// Compiled twice where the compiler can dispatch at run time (GCC/Clang on x86-64 ELF): with
-// AVX2 the window search is more than twice as fast (16 int16 lanes and a blend instruction
-// instead of 8 lanes and three logic ops), which makes it the faster exact method for all
-// blocks at the default reach.
-#if defined(__x86_64__) && defined(__ELF__) && (defined(__GNUC__) || defined(__clang__))
-#define CURVESFM_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
-bool cpuHasAvx2() { return __builtin_cpu_supports("avx2"); }
-#else
-#define CURVESFM_AVX2_CLONES
-bool cpuHasAvx2() { return false; }
-#endif
+// For every column, the nearest edge pixel in that column above (up_*) or below (down_*) the
+// row: squared distance, clamped to beyond = R + 1 (which keeps squares from overflowing and
+// marks the column as no site), in int32 and int16, and its index. Branch-free and on
+// non-overlapping arrays, so that it vectorises.
+CURVESFM_AVX2_CLONES
+void nearestInColumns(int row, int width, std::int32_t beyond,
+                      const std::int32_t* __restrict up_row,
+                      const std::int32_t* __restrict down_row,
+                      const std::int32_t* __restrict up_index,
+                      const std::int32_t* __restrict down_index, std::int32_t* __restrict squared,
+                      std::int16_t* __restrict squared16, std::int32_t* __restrict vertical_index) {
+  for (int c = 0; c < width; ++c) {
+    const std::int32_t up = row - up_row[c];
+    const std::int32_t down = down_row[c] - row;
+    const std::int32_t nearest = std::min(std::min(up, down), beyond);
+    squared[c] = nearest * nearest;
+    squared16[c] = static_cast<std::int16_t>(std::min(nearest * nearest, 32767));
+    const std::int32_t from_up = up_index[c];
+    const std::int32_t from_down = down_index[c];
+    vertical_index[c] = up <= down ? from_up : from_down;
+  }
+}
 
 // The window search on one block of kWindowBlock columns: the minimum over |k| <= passes of
-// squared[i + k] + k^2, grown k = 1, 2, ... until every minimum is at most (k + 1)^2 (no
-// farther column can beat it) or k reaches `reach`; then out[i] (i < count) is the minimising
-// column's vertical_index, or -1 beyond the reach. `squared` must be readable from -passes to
-// kWindowBlock + passes, vertical_index over the columns the search may pick. False (nothing
-// written) if `passes` do not settle the block.
+// squared[i + k] + k^2, grown k = 1, 2, ... until no farther column can change it; then out[i]
+// (i < count) is the minimising column's vertical_index, or -1 beyond the reach. `floor` is a
+// lower bound of `squared` over every column the search may reach, so columns farther than k
+// offer at least (k + 1)^2 + floor: the block is settled once every minimum is at most that, or
+// that exceeds R^2. `squared` must be readable from -passes to kWindowBlock + passes,
+// vertical_index over the columns the search may pick. False (nothing written) if `passes` do
+// not settle the block.
 CURVESFM_AVX2_CLONES
 bool searchWindow(const std::int16_t* __restrict squared,
                   const std::int32_t* __restrict vertical_index, int count, int passes, int reach,
-                  std::int32_t* __restrict out) {
+                  int floor, std::int32_t* __restrict out) {
   std::int16_t best[kWindowBlock];
   std::int16_t from[kWindowBlock];  // Offset of the minimising column.
   for (int i = 0; i < kWindowBlock; ++i) {
     best[i] = squared[i];
     from[i] = 0;
   }
+  const int reach_squared = reach * reach;
   for (int k = 1; k <= passes; ++k) {
     const auto pass = [&](const std::int16_t* shifted, std::int16_t offset) {
       const std::int16_t added = static_cast<std::int16_t>(k * k);
@@ -287,14 +351,16 @@ bool searchWindow(const std::int16_t* __restrict squared,
     // Left before right, both strict: ties go to the leftmost, deterministically.
     pass(squared - k, static_cast<std::int16_t>(-k));
     pass(squared + k, static_cast<std::int16_t>(k));
-    // Blocks settle within a few passes or not until the reach; checking every pass after the
-    // first few would cost more than it saves.
-    const bool last = k == passes || k == reach;
-    if (k > 4 && k % 4 != 0 && !last) continue;
-    std::int16_t worst = 0;
-    for (int i = 0; i < kWindowBlock; ++i) worst = std::max(worst, best[i]);
-    if (worst <= (k + 1) * (k + 1) || k == reach) {
-      const int reach_squared = reach * reach;
+    const int bound = (k + 1) * (k + 1) + floor;
+    bool settled = bound > reach_squared;
+    // Blocks settle within a few passes or late; checking every pass after the first few would
+    // cost more than it saves.
+    if (!settled && (k <= 4 || k % 4 == 0 || k == passes)) {
+      std::int16_t worst = 0;
+      for (int i = 0; i < kWindowBlock; ++i) worst = std::max(worst, best[i]);
+      settled = worst <= bound;
+    }
+    if (settled) {
       for (int i = 0; i < count; ++i) {
         out[i] = indexWithinReach(vertical_index[i + from[i]], best[i] <= reach_squared);
       }
@@ -312,47 +378,52 @@ bool searchWindow(const std::int16_t* __restrict squared,
 // and scratch memory is O(width + edges).
 //
 // The row pass has two exact methods, chosen per block of kBlock columns:
-//  - a window search, for blocks near many edges (dense edge maps, textured regions): the
-//    minimum over |x - c| <= k grows k = 1, 2, ... in SIMD-friendly passes over the block until
-//    every minimum is at most (k + 1)^2, when no farther column can beat it;
-//  - the lower envelope of the parabolas (Meijster), O(1) per column whatever the distances,
-//    for the remaining blocks, with the sites within R of them.
-// A block uses the method that worked for it in the row above (rows are alike), and every
+//  - the window search (searchWindow): the minimum over |x - c| <= k, grown k = 1, 2, ... in
+//    SIMD passes over the block until no farther column can change it. It needs at most R
+//    passes, so with R <= kMaxPasses (the default R = 15) it settles every block; dense edges
+//    settle it in two or three;
+//  - the lower envelope of the parabolas (Meijster), O(1) per column whatever R, from the sites
+//    within R of the block, for blocks the window search does not settle in kMaxPasses.
+// Blocks with no column near an edge pixel within R of them are beyond reach and skipped. A
+// block uses the method that worked for it in the row above (rows are alike), and every
 // kRetryRows rows the window search is tried again everywhere.
 class DistanceSweep {
  public:
-  DistanceSweep(const std::vector<EdgePixel>& edges, const std::vector<std::int32_t>& row_start,
-                int width, int height, int reach)
-      : edges_(edges),
-        row_start_(row_start),
+  DistanceSweep(const EdgeLayout& layout, int width, int height, int reach)
+      : column_(layout.column),
+        row_start_(layout.row_start),
         width_(width),
         height_(height),
         reach_(reach),
         blocks_((width + kBlock - 1) / kBlock),
         // Capped squares must stay exact in int16: (R + 1)^2 + kMaxPasses^2 < 2^15.
         window_enabled_(reach <= kMaxWindowReach),
-        max_passes_(std::min(reach, cpuHasAvx2() ? kMaxPassesAvx2 : kMaxPassesSse2)),
+        max_passes_(std::min(reach, kMaxPasses)),
         up_row_(width, -kFarRow),
         up_index_(width, -1),
         down_row_(width, kFarRow),
         down_index_(width, -1),
-        next_in_column_(edges.size(), -1),
+        next_in_column_(layout.column.size(), -1),
+        next_row_(layout.column.size(), kFarRow),
         squared_(width),
         vertical_index_(width),
         window_squared_(kMaxPasses + blocks_ * kBlock + kMaxPasses, cappedSquare(reach + 1)),
         window_easy_(blocks_, 1),
-        has_site_(blocks_),
-        near_site_(blocks_),
+        block_floor_(blocks_),
+        near_floor_(blocks_),
         site_(width),
         site_start_(width),
         site_value_(width),
         owner_(width) {
     // Each column's first edge pixel, and each edge pixel's successor in its column.
-    for (std::size_t e = edges.size(); e-- > 0;) {
-      const int column = static_cast<int>(edges[e].pixel.x());
-      next_in_column_[e] = down_index_[column];
-      down_index_[column] = static_cast<std::int32_t>(e);
-      down_row_[column] = static_cast<std::int32_t>(edges[e].pixel.y());
+    for (int row = height; row-- > 0;) {
+      for (int e = row_start_[row + 1]; e-- > row_start_[row];) {
+        const int column = column_[e];
+        next_in_column_[e] = down_index_[column];
+        next_row_[e] = down_row_[column];
+        down_index_[column] = e;
+        down_row_[column] = row;
+      }
     }
   }
 
@@ -362,9 +433,8 @@ class DistanceSweep {
       const int first = row_start_[row];
       const int last = row_start_[row + 1];
       for (int e = first; e < last; ++e) {
-        const int column = static_cast<int>(edges_[e].pixel.x());
-        up_row_[column] = row;
-        up_index_[column] = e;
+        up_row_[column_[e]] = row;
+        up_index_[column_[e]] = e;
       }
       if (hasEdgeWithinReach(row)) {
         columnPass(row);
@@ -373,10 +443,8 @@ class DistanceSweep {
         std::fill(out, out + width_, -1);
       }
       for (int e = first; e < last; ++e) {
-        const int column = static_cast<int>(edges_[e].pixel.x());
-        const std::int32_t next = next_in_column_[e];
-        down_index_[column] = next;
-        down_row_[column] = next < 0 ? kFarRow : static_cast<std::int32_t>(edges_[next].pixel.y());
+        down_index_[column_[e]] = next_in_column_[e];
+        down_row_[column_[e]] = next_row_[e];
       }
     }
   }
@@ -384,10 +452,8 @@ class DistanceSweep {
  private:
   static constexpr int kBlock = kWindowBlock;
   // Window passes before a block falls back to the envelope: about where the envelope becomes
-  // the cheaper method, with 16 and with 8 SIMD lanes. kMaxPasses pads the window's array.
-  static constexpr int kMaxPassesAvx2 = 16;
-  static constexpr int kMaxPassesSse2 = 4;
-  static constexpr int kMaxPasses = kMaxPassesAvx2;
+  // the cheaper method (measured with SSE2 and with AVX2). Also the padding of window_squared_.
+  static constexpr int kMaxPasses = 16;
   static constexpr int kMaxWindowReach = 127;
   static constexpr int kRetryRows = 8;
 
@@ -403,35 +469,12 @@ class DistanceSweep {
 
   void columnPass(int row) {
     nearestInColumns(row, width_, reach_ + 1, up_row_.data(), down_row_.data(), up_index_.data(),
-                     down_index_.data(), squared_.data(), vertical_index_.data(),
-                     window_squared_.data() + kMaxPasses);
-  }
-
-  // Branch-free and on non-overlapping arrays, so that it vectorises. Distances beyond R are
-  // clamped to `beyond` = R + 1, which keeps their squares from overflowing and marks them as
-  // no site.
-  static void nearestInColumns(int row, int width, std::int32_t beyond,
-                               const std::int32_t* __restrict up_row,
-                               const std::int32_t* __restrict down_row,
-                               const std::int32_t* __restrict up_index,
-                               const std::int32_t* __restrict down_index,
-                               std::int32_t* __restrict squared,
-                               std::int32_t* __restrict vertical_index,
-                               std::int16_t* __restrict window_squared) {
-    for (int c = 0; c < width; ++c) {
-      const std::int32_t up = row - up_row[c];
-      const std::int32_t down = down_row[c] - row;
-      const std::int32_t nearest = std::min(std::min(up, down), beyond);
-      squared[c] = nearest * nearest;
-      window_squared[c] = static_cast<std::int16_t>(std::min(nearest * nearest, 32767));
-      const std::int32_t from_up = up_index[c];
-      const std::int32_t from_down = down_index[c];
-      vertical_index[c] = up <= down ? from_up : from_down;
-    }
+                     down_index_.data(), squared_.data(), window_squared_.data() + kMaxPasses,
+                     vertical_index_.data());
   }
 
   void rowPass(int row, std::int32_t* out) {
-    markBlocksNearSites();
+    computeBlockFloors();
     const bool retry = row % kRetryRows == 0;
     int hard_begin = -1;  // First block of the current run of envelope blocks.
     const auto finishHardRun = [&](int end_block) {
@@ -439,7 +482,7 @@ class DistanceSweep {
       hard_begin = -1;
     };
     for (int b = 0; b < blocks_; ++b) {
-      if (!near_site_[b]) {
+      if (near_floor_[b] > reach_ * reach_) {
         finishHardRun(b);
         std::fill(out + b * kBlock, out + std::min((b + 1) * kBlock, width_), -1);
         continue;
@@ -456,35 +499,35 @@ class DistanceSweep {
     finishHardRun(blocks_);
   }
 
-  // near_site_[b]: a site (column within R of an edge pixel) may lie within R of block b. Large
-  // empty regions are common (more than half the pixels of a typical Canny map are beyond
-  // R = 15 px), and this lets the row pass skip them.
-  void markBlocksNearSites() {
-    const std::int32_t reach_squared = reach_ * reach_;
+  // near_floor_[b]: no column within R of block b is nearer than this (squared) to an edge pixel.
+  // Above R^2 the block is beyond reach: large empty regions are common (more than half the
+  // pixels of a typical Canny map are beyond R = 15 px) and the row pass skips them. Otherwise
+  // it lets the window search stop early.
+  void computeBlockFloors() {
     const std::int32_t* squared = squared_.data();
     for (int b = 0; b < blocks_; ++b) {
       const int begin = b * kBlock;
       const int end = std::min(begin + kBlock, width_);
-      std::int32_t smallest = reach_squared + 1;
+      std::int32_t smallest = (reach_ + 1) * (reach_ + 1);
       for (int c = begin; c < end; ++c) smallest = std::min(smallest, squared[c]);
-      has_site_[b] = smallest <= reach_squared ? 1 : 0;
+      block_floor_[b] = smallest;
     }
     const int span = (reach_ + kBlock - 1) / kBlock;
     for (int b = 0; b < blocks_; ++b) {
-      std::uint8_t near = 0;
+      std::int32_t smallest = (reach_ + 1) * (reach_ + 1);
       for (int n = std::max(0, b - span); n <= std::min(blocks_ - 1, b + span); ++n) {
-        near |= has_site_[n];
+        smallest = std::min(smallest, block_floor_[n]);
       }
-      near_site_[b] = near;
+      near_floor_[b] = smallest;
     }
   }
 
   // The window search on block b; false (nothing written) if it needs more than max_passes_.
   bool windowBlock(int b, std::int32_t* out) {
     const int begin = b * kBlock;
-    return searchWindow(window_squared_.data() + kMaxPasses + begin,
-                        vertical_index_.data() + begin, std::min(kBlock, width_ - begin),
-                        max_passes_, reach_, out + begin);
+    return searchWindow(window_squared_.data() + kMaxPasses + begin, vertical_index_.data() + begin,
+                        std::min(kBlock, width_ - begin), max_passes_, reach_, near_floor_[b],
+                        out + begin);
   }
 
   // 32-bit arithmetic is exact up to this width (squares of column differences plus R^2 fit an
@@ -561,11 +604,12 @@ class DistanceSweep {
     for (int x = begin; x < end; ++x) {
       current = std::max(current, owner[x]);
       const Int dx = x - current;
-      out[x] = indexWithinReach(vertical_index[current], dx * dx + squared[current] <= reach_squared);
+      out[x] =
+          indexWithinReach(vertical_index[current], dx * dx + squared[current] <= reach_squared);
     }
   }
 
-  const std::vector<EdgePixel>& edges_;
+  const std::vector<std::int32_t>& column_;
   const std::vector<std::int32_t>& row_start_;
   const int width_;
   const int height_;
@@ -578,7 +622,9 @@ class DistanceSweep {
   std::vector<std::int32_t> up_index_;
   std::vector<std::int32_t> down_row_;
   std::vector<std::int32_t> down_index_;
+  // Per edge pixel: the next edge pixel down its column (-1 if none) and that one's row.
   std::vector<std::int32_t> next_in_column_;
+  std::vector<std::int32_t> next_row_;
   // Per column of the current row: squared distance to the column's nearest edge pixel (clamped
   // to (R + 1)^2) and its index; the squares again in int16 for the window search, padded with
   // (R + 1)^2 by kMaxPasses on the left and to whole blocks plus kMaxPasses on the right.
@@ -586,8 +632,10 @@ class DistanceSweep {
   std::vector<std::int32_t> vertical_index_;
   std::vector<std::int16_t> window_squared_;
   std::vector<std::uint8_t> window_easy_;  // Per block: the window search worked last time.
-  std::vector<std::uint8_t> has_site_;     // Per block: it holds a column within R of an edge.
-  std::vector<std::uint8_t> near_site_;    // Per block: a site may lie within R of it.
+  // Per block: the smallest column distance^2 (clamped to (R + 1)^2) in it, and in the blocks
+  // within R of it, a lower bound over every site that can matter to the block.
+  std::vector<std::int32_t> block_floor_;
+  std::vector<std::int32_t> near_floor_;
   // The lower envelope: site columns, the first column each wins and its g^2; then each
   // column's site.
   std::vector<std::int32_t> site_;
@@ -616,21 +664,18 @@ NearestEdgeField NearestEdgeField::build(const cv::Mat& edges, const cv::Mat& gr
   CURVESFM_CHECK(grad_x.type() == CV_16SC1 || grad_x.type() == CV_32FC1)
       << "gradients must be CV_16SC1 or CV_32FC1, got type " << grad_x.type();
   CURVESFM_CHECK(grad_x.size() == edges.size() && grad_y.size() == edges.size())
-      << "edges " << edges.size() << ", grad_x " << grad_x.size() << " and grad_y "
-      << grad_y.size() << " must have the same size";
+      << "edges " << edges.size() << ", grad_x " << grad_x.size() << " and grad_y " << grad_y.size()
+      << " must have the same size";
 
   NearestEdgeField field;
   field.width_ = edges.cols;
   field.height_ = edges.rows;
   field.max_distance_px_ = options.max_distance_px;
-  std::vector<std::int32_t> row_start;
-  if (grad_x.type() == CV_16SC1) {
-    collectEdges<std::int16_t>(edges, grad_x, grad_y, &field.edges_, &row_start);
-  } else {
-    collectEdges<float>(edges, grad_x, grad_y, &field.edges_, &row_start);
-  }
+  const EdgeLayout layout = grad_x.type() == CV_16SC1
+                                ? collectEdges<std::int16_t>(edges, grad_x, grad_y, &field.edges_)
+                                : collectEdges<float>(edges, grad_x, grad_y, &field.edges_);
   field.index_.resize(static_cast<std::size_t>(field.width_) * field.height_);
-  DistanceSweep(field.edges_, row_start, field.width_, field.height_, options.max_distance_px)
+  DistanceSweep(layout, field.width_, field.height_, options.max_distance_px)
       .run(field.index_.data());
   return field;
 }

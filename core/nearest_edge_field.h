@@ -2,6 +2,9 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -14,10 +17,11 @@ namespace curvesfm {
 struct EdgePixel {
   /// Centre of the edge pixel: exactly (column, row).
   Eigen::Vector2f pixel = Eigen::Vector2f::Zero();
-  /// Sub-pixel edge position: the pixel centre moved along `normal` to the maximum of a parabola
-  /// through the gradient magnitudes at the pixel and its two neighbours across the edge, the
-  /// offset clamped to [-0.5, 0.5] px. Equal to `pixel` where the fit is not defined (flat or
-  /// non-concave magnitude profile, image border).
+  /// Sub-pixel edge position: the pixel centre moved along `normal` to the vertex of the parabola
+  /// through the logarithms of the gradient magnitudes at the pixel and at its two 8-neighbours
+  /// along the gradient direction (a Gaussian fit of the magnitude profile across the edge), the
+  /// shift clamped to [-0.5, 0.5] px. Equal to `pixel` where the profile has no maximum (flat or
+  /// convex) or a neighbour lies outside the image.
   Eigen::Vector2f subpixel = Eigen::Vector2f::Zero();
   /// Unit image gradient direction at the edge pixel (the edge normal, pointing dark to bright).
   Eigen::Vector2f normal = Eigen::Vector2f(1.0f, 0.0f);
@@ -37,8 +41,10 @@ struct NearestEdgeFieldOptions {
 /// arbitrarily but deterministically) with its sub-pixel position and unit gradient.
 ///
 /// Built once per keyframe in O(pixels) by an exact separable distance transform that carries the
-/// argmin. Memory: 4 bytes per pixel (an index into the edge list, -1 beyond R) plus 24 bytes per
-/// edge pixel. Immutable after construction, so lookups are thread-safe.
+/// argmin (per row: the nearest edge pixel in each column, then the best column by a bounded
+/// window search or the lower envelope of parabolas); docs/benchmarks.md compares it with
+/// cv::distanceTransform. Memory: 4 bytes per pixel (an index into the edge list, -1 beyond R)
+/// plus 24 bytes per edge pixel. Immutable after construction, so lookups are thread-safe.
 class NearestEdgeField {
  public:
   /// An empty 0 x 0 field (every lookup misses).
@@ -81,10 +87,32 @@ class NearestEdgeField {
   }
 
  private:
+  // Leaves value-initialised elements (resize) uninitialised: build() writes every entry, and
+  // zeroing megabytes first would cost about 5 % of it.
+  template <class T>
+  struct UninitialisedAllocator : std::allocator<T> {
+    template <class U>
+    struct rebind {
+      using other = UninitialisedAllocator<U>;
+    };
+    UninitialisedAllocator() = default;
+    template <class U>
+    UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+    template <class U>
+    void construct(U* p) noexcept {
+      ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+  };
+
   int width_ = 0;
   int height_ = 0;
   int max_distance_px_ = 0;
-  std::vector<std::int32_t> index_;  // Per pixel, row-major: index into edges_, or -1.
+  // Per pixel, row-major: index into edges_, or -1.
+  std::vector<std::int32_t, UninitialisedAllocator<std::int32_t>> index_;
   std::vector<EdgePixel> edges_;
 };
 

@@ -37,23 +37,18 @@
 #include <string>
 #include <vector>
 
+#include "benchmarks/support/bench_common.h"
 #include "core/errors.h"
 #include "core/nearest_edge_field.h"
 
 namespace curvesfm {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::median;
+using bench::print;
 
-double millisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> samples) {
-  std::sort(samples.begin(), samples.end());
-  const std::size_t n = samples.size();
-  return n % 2 == 1 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
-}
+double millisecondsSince(Clock::time_point start) { return 1e3 * bench::secondsSince(start); }
 
 struct BenchOptions {
   int repeats = 5;    ///< Timed builds per method and case; the median is reported; >= 1.
@@ -163,7 +158,6 @@ Comparison compare(const NearestEdgeField& field, const cv::Mat& dist, const cv:
   return comparison;
 }
 
-void print(const std::string& key, double value) { std::printf("%s: %.6g\n", key.c_str(), value); }
 
 // Speedup of one case: OpenCV median time over nnfield median time.
 double runCase(const EdgeCase& edge_case, const BenchOptions& bench) {
@@ -255,15 +249,5 @@ int main(int argc, char** argv) {
   app.add_option("--reach", bench.reach, "Reach R of the field (px)")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
-  try {
-    return curvesfm::run(bench);
-  } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
-    return 1;
-  }
+  return curvesfm::bench::parseAndRun(app, argc, argv, [&] { return curvesfm::run(bench); });
 }

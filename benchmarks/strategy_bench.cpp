@@ -88,15 +88,17 @@ struct Run {
   bool converged = false;
 };
 
-// A scene with its nearest-edge fields, built once and solved many times.
+// A scene with its nearest-edge fields and the errors of its start, built once and solved many
+// times.
 struct PreparedScene {
   std::string name;
   CurveScene scene;
   CurveBundleAdjustmentInput input;
+  CurveSceneErrors before;
 };
 
 PreparedScene prepare(const NamedScene& named) {
-  PreparedScene prepared{named.name, makeCurveScene(named.options), {}};
+  PreparedScene prepared{named.name, makeCurveScene(named.options), {}, {}};
   const CurveScene& scene = prepared.scene;
   CurveBundleAdjustmentInput& input = prepared.input;
   input.camera = scene.camera;
@@ -110,6 +112,7 @@ PreparedScene prepare(const NamedScene& named) {
   for (const CurveObservation& obs : scene.observations) {
     input.observations.push_back({obs.curve_index, obs.segment_index, obs.keyframe_index});
   }
+  prepared.before = evaluateCurveScene(scene, input.cam_from_world, input.curves);
   return prepared;
 }
 
@@ -132,14 +135,10 @@ Run solve(const PreparedScene& prepared, const Config& config, int max_iteration
   run.seconds = bench::secondsSince(start);
   run.scene = prepared.name;
   run.config = config;
-  std::vector<Pose3> poses;
-  for (std::size_t j = 0; j < prepared.input.cam_from_world.size(); ++j) {
-    poses.push_back(problem.values.at<Pose3>(poseKey(j)));
-  }
-  run.before = evaluateCurveScene(prepared.scene, prepared.input.cam_from_world,
-                                  prepared.input.curves);
-  run.after = evaluateCurveScene(prepared.scene, poses,
-                                 extractCurves(problem.values, prepared.input.curves));
+  run.before = prepared.before;
+  run.after = evaluateCurveScene(
+      prepared.scene, extractPoses(problem.values, prepared.input.cam_from_world.size()),
+      extractCurves(problem.values, prepared.input.curves));
   run.iterations = report.total_iterations;
   run.final_cost = report.final_cost;
   run.converged = report.converged;
@@ -402,8 +401,8 @@ int run(const BenchOptions& options) {
   bench::print("best_curve_mm", best.curve_mm);
   for (const Aggregate& a : aggregate(edge_runs)) {
     const std::string prefix = a.config.subpixel ? "subpixel_" : "integer_";
-    bench::print((prefix + "ate_mm").c_str(), a.ate_mm);
-    bench::print((prefix + "curve_mm").c_str(), a.curve_mm);
+    bench::print(prefix + "ate_mm", a.ate_mm);
+    bench::print(prefix + "curve_mm", a.curve_mm);
   }
   bench::print("total_seconds", bench::secondsSince(start));
   bench::printText("outputs", (out / "{runs.csv,summary.md,*.png}").string());

@@ -67,8 +67,14 @@ class NearestEdgeField {
   /// (round(x), round(y)); nullptr if that pixel is outside the image, beyond the reach R, or
   /// (x, y) is not finite. Allocation-free and exception-free: meant for the inner loop.
   const EdgePixel* nearest(double x, double y) const {
-    if (!(x > -0.5 && y > -0.5 && x < width_ - 0.5 && y < height_ - 0.5)) return nullptr;
+    if (!contains(x, y)) return nullptr;
     return nearestToPixel(static_cast<int>(x + 0.5), static_cast<int>(y + 0.5));
+  }
+
+  /// True if (x, y) rounds to a pixel of the image, i.e. lies in (-0.5, width - 0.5) x
+  /// (-0.5, height - 0.5); false for non-finite coordinates.
+  bool contains(double x, double y) const {
+    return x > -0.5 && y > -0.5 && x < width_ - 0.5 && y < height_ - 0.5;
   }
 
   /// The nearest edge pixel to pixel (column, row), or nullptr outside the image or beyond R.

@@ -22,9 +22,9 @@ SampleHit locateSample(const Camera& camera, const NearestEdgeField& field,
   }
   const EdgePixel* edge = field.nearest((*pixel)[0], (*pixel)[1]);
   if (edge) return {SampleOutcome::kOnField, edge};
-  const bool inside = (*pixel)[0] > -0.5 && (*pixel)[1] > -0.5 &&
-                      (*pixel)[0] < field.width() - 0.5 && (*pixel)[1] < field.height() - 0.5;
-  return {inside ? SampleOutcome::kBeyondReach : SampleOutcome::kOutsideImage, nullptr};
+  return {field.contains((*pixel)[0], (*pixel)[1]) ? SampleOutcome::kBeyondReach
+                                                   : SampleOutcome::kOutsideImage,
+          nullptr};
 }
 
 BezierSegmentParams segmentParams(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,

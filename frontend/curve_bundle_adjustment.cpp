@@ -6,7 +6,6 @@
 
 #include "core/check.h"
 #include "core/errors.h"
-#include "frontend/scale_gauge.h"
 #include "factors/segment_length_factor.h"
 #include "factors/tangent_alignment_factor.h"
 

@@ -9,6 +9,7 @@
 #include "core/pose3.h"
 #include "core/segment_observation.h"
 #include "factors/curve_reprojection_factor.h"
+#include "frontend/pose_variables.h"
 #include "graph/factor_graph.h"
 #include "graph/optimizer.h"
 #include "graph/robust_kernel.h"

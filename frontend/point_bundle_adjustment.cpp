@@ -4,7 +4,6 @@
 
 #include "core/check.h"
 #include "core/errors.h"
-#include "frontend/scale_gauge.h"
 #include "factors/point_reprojection_factor.h"
 
 namespace curvesfm {
@@ -53,12 +52,6 @@ PointBundleAdjustmentProblem buildPointBundleAdjustment(
                   &problem.graph);
   }
   return problem;
-}
-
-std::vector<Pose3> extractPoses(const Values& values, std::size_t num_cameras) {
-  std::vector<Pose3> poses;
-  for (std::size_t i = 0; i < num_cameras; ++i) poses.push_back(values.at<Pose3>(poseKey(i)));
-  return poses;
 }
 
 std::vector<Eigen::Vector3d> extractPoints(const Values& values, std::size_t num_points) {

@@ -7,6 +7,7 @@
 #include "core/camera.h"
 #include "core/point_observation.h"
 #include "core/pose3.h"
+#include "frontend/pose_variables.h"
 #include "graph/factor_graph.h"
 #include "graph/optimizer.h"
 #include "graph/robust_kernel.h"
@@ -51,8 +52,7 @@ struct PointBundleAdjustmentProblem {
 PointBundleAdjustmentProblem buildPointBundleAdjustment(const PointBundleAdjustmentInput& input,
                                                         const PointBundleAdjustmentOptions& options);
 
-/// The poses and points of `values`, in input order.
-std::vector<Pose3> extractPoses(const Values& values, std::size_t num_cameras);
+/// The points of `values`, in input order (extractPoses gives the poses).
 std::vector<Eigen::Vector3d> extractPoints(const Values& values, std::size_t num_points);
 
 }  // namespace curvesfm

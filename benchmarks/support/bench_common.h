@@ -30,11 +30,17 @@ inline double median(std::vector<double> samples) {
   return n % 2 == 1 ? samples[n / 2] : 0.5 * (samples[n / 2 - 1] + samples[n / 2]);
 }
 
-inline void print(const char* key, double value) { std::printf("%s: %.6g\n", key, value); }
-inline void printPrecise(const char* key, double value) { std::printf("%s: %.12g\n", key, value); }
-inline void printInt(const char* key, long long value) { std::printf("%s: %lld\n", key, value); }
-inline void printText(const char* key, const std::string& value) {
-  std::printf("%s: %s\n", key, value.c_str());
+inline void print(const std::string& key, double value) {
+  std::printf("%s: %.6g\n", key.c_str(), value);
+}
+inline void printPrecise(const std::string& key, double value) {
+  std::printf("%s: %.12g\n", key.c_str(), value);
+}
+inline void printInt(const std::string& key, long long value) {
+  std::printf("%s: %lld\n", key.c_str(), value);
+}
+inline void printText(const std::string& key, const std::string& value) {
+  std::printf("%s: %s\n", key.c_str(), value.c_str());
 }
 
 /// Parses the command line of `app`, then runs `run`. Exit codes as the curvesfm binary: 2 for

@@ -1065,7 +1065,9 @@ LegendEntry legendEntry(const PlotSeries& s, int index) {
   return entry;
 }
 
-ChartSpec plotSpec(const PlotOptions& options, const std::vector<PlotSeries>& series) {
+// The title, labels, size, font and legend placement every chart kind takes from its options.
+template <class Options>
+ChartSpec labelledSpec(const Options& options) {
   ChartSpec spec;
   spec.title = options.title;
   spec.x_label = options.x_label;
@@ -1073,6 +1075,11 @@ ChartSpec plotSpec(const PlotOptions& options, const std::vector<PlotSeries>& se
   spec.size = {options.width, options.height};
   spec.font_scale = options.font_scale;
   spec.legend_position = options.legend;
+  return spec;
+}
+
+ChartSpec plotSpec(const PlotOptions& options, const std::vector<PlotSeries>& series) {
+  ChartSpec spec = labelledSpec(options);
   spec.x = options.x_range ? rangeSpec(options.x_range, options.log_x)
                            : autoRange(drawableValues(series, options, true), options.log_x);
   spec.y = options.y_range ? rangeSpec(options.y_range, options.log_y)
@@ -1233,13 +1240,7 @@ std::string barNote(const std::vector<BarSeries>& series, bool log) {
 
 ChartSpec barSpec(const std::vector<std::string>& categories, const BarChartOptions& options,
                   const std::vector<BarSeries>& series) {
-  ChartSpec spec;
-  spec.title = options.title;
-  spec.x_label = options.x_label;
-  spec.y_label = options.y_label;
-  spec.size = {options.width, options.height};
-  spec.font_scale = options.font_scale;
-  spec.legend_position = options.legend;
+  ChartSpec spec = labelledSpec(options);
   spec.x.hi = static_cast<double>(categories.size());
   spec.x.categories = categories;
   std::vector<double> values;

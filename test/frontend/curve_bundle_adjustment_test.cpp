@@ -2,6 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
+#include "core/errors.h"
+
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
 
@@ -40,11 +45,9 @@ Solved solve(const CurveScene& scene, Strategy strategy,
   Solved solved;
   solved.before = evaluateCurveScene(scene, input.cam_from_world, input.curves);
   solved.report = runSchedule(problem.graph, &problem.values, problem.config, scheduler);
-  std::vector<Pose3> poses;
-  for (std::size_t j = 0; j < input.cam_from_world.size(); ++j) {
-    poses.push_back(problem.values.at<Pose3>(poseKey(j)));
-  }
-  solved.after = evaluateCurveScene(scene, poses, extractCurves(problem.values, input.curves));
+  solved.after = evaluateCurveScene(scene,
+                                    extractPoses(problem.values, input.cam_from_world.size()),
+                                    extractCurves(problem.values, input.curves));
   return solved;
 }
 
@@ -106,6 +109,54 @@ TEST(CurveBundleAdjustment, PartlyHiddenCurvesStayNearTheTruth) {
   const Solved solved = solve(scene, Strategy::kJoint);
   EXPECT_LT(solved.after.position_ate_sim3, 0.007);
   EXPECT_LT(solved.after.curve_mean_error_aligned, 0.01);
+}
+
+TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
+  const auto expectRejected = [](CurveBundleAdjustmentOptions options, const std::string& field) {
+    try {
+      options.validate();
+      ADD_FAILURE() << field << " accepted";
+    } catch (const InvalidOptions& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  CurveBundleAdjustmentOptions options;
+  EXPECT_NO_THROW(options.validate());
+  options.samples_per_segment = 0;
+  expectRejected(options, "samples_per_segment");
+  options = {};
+  options.samples_per_segment = CurveReprojectionFactor::kMaxSamples;
+  expectRejected(options, "samples_per_segment");
+  options = {};
+  options.lambda1 = -1.0;
+  expectRejected(options, "lambda1");
+  options = {};
+  options.lambda2 = std::nan("");
+  expectRejected(options, "lambda2");
+  options = {};
+  options.kernel_width = 0.0;
+  expectRejected(options, "kernel_width");
+  options = {};
+  options.pixel_sigma = -1.0;
+  expectRejected(options, "pixel_sigma");
+}
+
+TEST(CurveBundleAdjustment, RejectsMismatchedFieldsAndObservationsOutOfRange) {
+  CurveSceneOptions options;
+  options.num_keyframes = 3;
+  options.num_curves = 2;
+  const CurveScene scene = makeCurveScene(options);
+  CurveBundleAdjustmentInput input = startingGuess(scene);
+  CurveBundleAdjustmentInput missing_field = input;
+  missing_field.fields.pop_back();
+  EXPECT_THROW(buildCurveBundleAdjustment(missing_field, {}), CheckError);
+  CurveBundleAdjustmentInput bad_observation = input;
+  bad_observation.observations.push_back({0, scene.true_curves[0].numSegments(), 0});
+  EXPECT_THROW(buildCurveBundleAdjustment(bad_observation, {}), CheckError);
+  CurveBundleAdjustmentInput wrong_size = input;
+  wrong_size.fields[1] = std::make_shared<const NearestEdgeField>();
+  EXPECT_THROW(buildCurveBundleAdjustment(wrong_size, {}), CheckError);
+  EXPECT_NO_THROW(buildCurveBundleAdjustment(input, {}));
 }
 
 }  // namespace

@@ -1,4 +1,4 @@
-#include "frontend/scale_gauge.h"
+#include "frontend/pose_variables.h"
 
 #include "core/check.h"
 #include "factors/pose_prior_factor.h"
@@ -14,6 +14,13 @@ void addScaleGauge(const std::vector<Pose3>& cam_from_world, double distance, do
           : (cam_from_world[1].inverseTranslation() - cam_from_world[0].inverseTranslation())
                 .norm();
   graph->emplace<CameraDistanceFactor>(poseKey(0), poseKey(1), fixed, NoiseModel{sigma, {}});
+}
+
+std::vector<Pose3> extractPoses(const Values& values, std::size_t num_poses) {
+  std::vector<Pose3> poses;
+  poses.reserve(num_poses);
+  for (std::size_t i = 0; i < num_poses; ++i) poses.push_back(values.at<Pose3>(poseKey(i)));
+  return poses;
 }
 
 }  // namespace curvesfm

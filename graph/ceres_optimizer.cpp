@@ -33,6 +33,9 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values,
     summary.ordering = ceres_options.linear_solver_ordering ? "structure_first"
                                                             : "automatic (" + why_not + ")";
   }
+  if (options.use_inner_iterations) {
+    ceres_options.inner_iteration_ordering = bridge.innerIterationOrdering();
+  }
   summary.num_constant_variables = bridge.numConstant();
   summary.num_free_variables = static_cast<int>(bridge.keys().size()) - bridge.numConstant();
   summary.setup_seconds = secondsSince(start);

@@ -40,9 +40,9 @@ CeresProblem::CeresProblem(const FactorGraph& graph, const Values& values,
       blocks.push_back(it != offsets_.end() ? storage_.data() + it->second
                                             : addVariable(key, used.at(key), values));
     }
-    problem_->AddResidualBlock(new FactorCostFunction(factor),
-                               const_cast<ceres::LossFunction*>(lossFor(factor->noiseModel().kernel)),
-                               blocks);
+    problem_->AddResidualBlock(
+        new FactorCostFunction(factor),
+        const_cast<ceres::LossFunction*>(lossFor(factor->noiseModel().kernel)), blocks);
     factor_types_.push_back(typeIndex(factor->typeName()));
     factor_blocks_.insert(factor_blocks_.end(), blocks.begin(), blocks.end());
     max_residual_dimension_ = std::max(max_residual_dimension_, factor->residualDimension());
@@ -143,6 +143,40 @@ std::shared_ptr<ceres::ParameterBlockOrdering> CeresProblem::structureFirstOrder
   return ordering;
 }
 
+std::shared_ptr<ceres::ParameterBlockOrdering> CeresProblem::innerIterationOrdering() const {
+  // Free neighbours of each block: variables that share a factor with it.
+  std::unordered_map<Key, std::size_t> index;
+  for (std::size_t i = 0; i < keys_.size(); ++i) {
+    if (!config_.isConstant(keys_[i])) index.emplace(keys_[i], i);
+  }
+  std::vector<std::vector<std::size_t>> neighbours(keys_.size());
+  for (const auto& factor : graph_) {
+    for (Key a : factor->keys()) {
+      const auto ia = index.find(a);
+      if (ia == index.end()) continue;
+      for (Key b : factor->keys()) {
+        const auto ib = index.find(b);
+        if (ib != index.end() && ib->second != ia->second)
+          neighbours[ia->second].push_back(ib->second);
+      }
+    }
+  }
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  std::vector<int> group(keys_.size(), -1);
+  std::vector<char> taken;
+  for (std::size_t i = 0; i < keys_.size(); ++i) {
+    if (!index.count(keys_[i])) continue;
+    taken.assign(neighbours[i].size() + 1, 0);
+    for (std::size_t n : neighbours[i]) {
+      if (group[n] >= 0 && group[n] < static_cast<int>(taken.size())) taken[group[n]] = 1;
+    }
+    group[i] = static_cast<int>(std::find(taken.begin(), taken.end(), 0) - taken.begin());
+    ordering->AddElementToGroup(const_cast<double*>(storage_.data()) + offsets_.at(keys_[i]),
+                                group[i]);
+  }
+  return ordering;
+}
+
 ceres::Solver::Options toCeresOptions(const OptimizerOptions& options) {
   ceres::Solver::Options ceres_options;
   switch (options.linear_solver) {
@@ -161,9 +195,8 @@ ceres::Solver::Options toCeresOptions(const OptimizerOptions& options) {
       break;
   }
   ceres_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
-  ceres_options.trust_region_strategy_type = options.trust_region == TrustRegion::kDogleg
-                                                 ? ceres::DOGLEG
-                                                 : ceres::LEVENBERG_MARQUARDT;
+  ceres_options.trust_region_strategy_type =
+      options.trust_region == TrustRegion::kDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
   ceres_options.max_num_iterations = options.max_iterations;
   ceres_options.num_threads = options.num_threads;
   ceres_options.function_tolerance = options.function_tolerance;

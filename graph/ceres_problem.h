@@ -49,6 +49,13 @@ class CeresProblem {
   /// the eliminated group must be an independent set.
   std::shared_ptr<ceres::ParameterBlockOrdering> structureFirstOrdering(std::string* why_not) const;
 
+  /// Independent sets of the free variables for Ceres' inner iterations, by first-fit colouring
+  /// in the order the blocks were added: group 0 is a maximal independent set, group 1 one of the
+  /// rest, and so on (the structure of Ceres' own recursive choice). Ceres builds its choice
+  /// from a hash set of its block pointers, so it changes with heap addresses and so do the
+  /// results; this one depends only on the graph.
+  std::shared_ptr<ceres::ParameterBlockOrdering> innerIterationOrdering() const;
+
  private:
   /// Adds the parameter block of `key` (initialised from `values`) and returns it.
   double* addVariable(Key key, VariableType type, const Values& values);

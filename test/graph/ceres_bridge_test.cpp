@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <set>
 
 #include "core/so3.h"
 #include "graph/ceres_cost_function.h"
@@ -187,6 +188,30 @@ TEST(Optimize, FallsBackToAutomaticOrderingWhenStructureIsCoupled) {
       optimize(toy.graph, &values, posesConstant(), OptimizerOptions());
   // AllTypesFactor ties the point, direction and scale together: not an independent set.
   EXPECT_EQ(summary.ordering.rfind("automatic (factor couples", 0), 0u) << summary.ordering;
+}
+
+TEST(CeresProblem, InnerIterationOrderingHoldsEveryFreeBlockInIndependentSets) {
+  ToyProblem toy = makeToyProblem();
+  ProblemConfig config;
+  config.setConstant(poseKey(0));
+  CeresProblem bridge(toy.graph, toy.start, config);
+  const auto ordering = bridge.innerIterationOrdering();
+  // Free: poses 1..4, the point, the direction and the length; pose 0 is constant.
+  EXPECT_EQ(ordering->NumElements(), 7);
+  EXPECT_FALSE(ordering->IsMember(bridge.block(poseKey(0))));
+  // The point, direction and length share every factor, so each needs a group of its own; the
+  // poses share factors with those three only, so they fit in one more.
+  EXPECT_EQ(ordering->NumGroups(), 4);
+  for (const auto& factor : toy.graph) {
+    std::set<int> groups;
+    int members = 0;
+    for (Key key : factor->keys()) {
+      if (!ordering->IsMember(bridge.block(key))) continue;
+      ++members;
+      groups.insert(ordering->GroupId(bridge.block(key)));
+    }
+    EXPECT_EQ(static_cast<int>(groups.size()), members) << "two blocks of one factor share a group";
+  }
 }
 
 TEST(Optimize, MissingOrMistypedVariablesThrowBeforeSolving) {

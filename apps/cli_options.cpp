@@ -1,5 +1,7 @@
 #include "apps/cli_options.h"
 
+#include <algorithm>
+#include <initializer_list>
 #include <memory>
 
 #include "core/errors.h"
@@ -9,32 +11,44 @@
 namespace curvesfm {
 namespace {
 
-// `--name VALUE` for an enum: the option keeps the name the user gave (so the echoed
-// configuration shows names), a check rejects unknown names with the list of accepted ones,
-// and the parsed value lands in `*target`.
+// The scene enums have no names in sim; the command line and the reports are their only readers.
 template <class Enum>
-CLI::Option* addEnumOption(CLI::App* command, const std::string& name, Enum* target,
-                           Enum (*parse)(const std::string&, const std::string&),
-                           const std::string& description) {
-  const std::string field = name;
-  return command
-      ->add_option_function<std::string>(
-          "--" + name, [target, parse, field](const std::string& value) {
-            *target = parse(value, field);
-          },
-          description)
-      ->check(CLI::Validator(
-          [parse, field](std::string& value) -> std::string {
-            try {
-              parse(value, field);
-              return "";
-            } catch (const InvalidOptions& e) {
-              return e.what();
-            }
-          },
-          "NAME"))
-      ->default_str(toString(*target));
+Enum parseSceneEnum(const std::string& name, const std::string& field,
+                    std::initializer_list<Enum> all) {
+  std::string accepted;
+  for (Enum value : all) {
+    if (name == toString(value)) return value;
+    accepted += (accepted.empty() ? "" : ", ") + toString(value);
+  }
+  throw InvalidOptions("CurveSceneOptions", field, "\"" + name + "\"",
+                       "expected one of " + accepted);
 }
+
+// The selected (possibly nested) sub-command's --config file, or empty when none was given.
+std::string configPath(const CLI::App& app, const CLI::App** selected) {
+  for (const CLI::App* command : app.get_subcommands()) {
+    const CLI::Option* config = command->get_option_no_throw("--config");
+    if (config && config->count() > 0) {
+      *selected = command;
+      return config->as<std::string>();
+    }
+    const std::string nested = configPath(*command, selected);
+    if (!nested.empty()) return nested;
+  }
+  return "";
+}
+
+// Where `command`'s own flags begin in `args`: after its name, which for a nested sub-command
+// is looked up after its parent's (a flag value may spell a command name too).
+std::vector<std::string>::iterator afterCommandName(const CLI::App& command,
+                                                    std::vector<std::string>* args) {
+  auto begin = args->begin();
+  const CLI::App* parent = command.get_parent();
+  if (parent && parent->get_parent()) begin = afterCommandName(*parent, args);
+  return std::find(begin, args->end(), command.get_name()) + 1;
+}
+
+}  // namespace
 
 nlohmann::json costsToJson(const std::map<std::string, FactorTypeCost>& costs) {
   nlohmann::json json = nlohmann::json::object();
@@ -42,14 +56,34 @@ nlohmann::json costsToJson(const std::map<std::string, FactorTypeCost>& costs) {
   return json;
 }
 
-}  // namespace
+CLI::Option* addBoolFlag(CLI::App* command, const std::string& name, bool* target,
+                         const std::string& description) {
+  // Normalised so that the echoed configuration reads true or false whatever was typed.
+  const CLI::Validator spellings(
+      [](std::string& value) -> std::string {
+        const std::string lower = CLI::detail::to_lower(value);
+        if (lower == "true" || lower == "yes" || lower == "on" || lower == "1") {
+          value = "true";
+        } else if (lower == "false" || lower == "no" || lower == "off" || lower == "0") {
+          value = "false";
+        } else {
+          return "expected true or false (or yes/no, on/off, 1/0), found '" + value + "'";
+        }
+        return "";
+      },
+      "");
+  return command->add_option("--" + name, *target, description)
+      ->transform(spellings)
+      ->type_name("BOOL")
+      ->default_str(*target ? "true" : "false");
+}
 
 void addOptimizerFlags(CLI::App* command, OptimizerOptions* options) {
-  addEnumOption(command, "linear-solver", &options->linear_solver, parseLinearSolver,
-                "Linear solver of each step: sparse_schur, dense_schur, iterative_schur, "
-                "sparse_normal_cholesky");
-  addEnumOption(command, "trust-region", &options->trust_region, parseTrustRegion,
-                "Trust-region strategy: levenberg_marquardt, dogleg");
+  addEnumFlag(command, "linear-solver", &options->linear_solver, parseLinearSolver,
+              "Linear solver of each step: sparse_schur, dense_schur, iterative_schur, "
+              "sparse_normal_cholesky");
+  addEnumFlag(command, "trust-region", &options->trust_region, parseTrustRegion,
+              "Trust-region strategy: levenberg_marquardt, dogleg");
   command->add_option("--max-iterations", options->max_iterations, "Maximum solver iterations")
       ->capture_default_str();
   command->add_option("--threads", options->num_threads, "Solver threads")->capture_default_str();
@@ -71,8 +105,78 @@ void addOptimizerFlags(CLI::App* command, OptimizerOptions* options) {
 
 CLI::Option* addKernelFlag(CLI::App* command, const std::string& name, RobustKernelType* kernel,
                            const std::string& description) {
-  return addEnumOption(command, name, kernel, parseRobustKernelType,
-                       description + ": none, huber, cauchy, tukey");
+  return addEnumFlag(command, name, kernel, parseRobustKernelType,
+                     description + ": none, huber, cauchy, tukey");
+}
+
+void addSchedulerFlags(CLI::App* command, SchedulerOptions* options) {
+  addEnumFlag(command, "strategy", &options->strategy, parseStrategy,
+              "How the free variables are split into solves: joint, alternating (poses, then "
+              "structure, per round), inner_iterations");
+  addEnumFlag(command, "scope", &options->scope, parseScope,
+              "Free variables: global (all), local (the last --local-window cameras and the "
+              "structure they see)");
+  command->add_option("--local-window", options->local_window, "Free cameras in local scope")
+      ->capture_default_str();
+  command->add_option("--max-rounds", options->max_rounds, "Alternating: most rounds")
+      ->capture_default_str();
+  command->add_option("--round-tolerance", options->round_tolerance,
+                      "Alternating: stop when a round lowers the cost by less than this fraction")
+      ->capture_default_str();
+  addOptimizerFlags(command, &options->optimizer);
+}
+
+std::string toString(CameraPath path) {
+  switch (path) {
+    case CameraPath::kOrbit:
+      return "orbit";
+    case CameraPath::kForwardWalk:
+      return "forward_walk";
+  }
+  return "unknown";
+}
+
+std::string toString(CurveKind kind) {
+  switch (kind) {
+    case CurveKind::kLine:
+      return "line";
+    case CurveKind::kArc:
+      return "arc";
+    case CurveKind::kHelix:
+      return "helix";
+    case CurveKind::kMixed:
+      return "mixed";
+  }
+  return "unknown";
+}
+
+CameraPath parseCameraPath(const std::string& name, const std::string& field) {
+  return parseSceneEnum(name, field, {CameraPath::kOrbit, CameraPath::kForwardWalk});
+}
+
+CurveKind parseCurveKind(const std::string& name, const std::string& field) {
+  return parseSceneEnum(name, field,
+                        {CurveKind::kLine, CurveKind::kArc, CurveKind::kHelix, CurveKind::kMixed});
+}
+
+void parseCommandLine(CLI::App* app, const std::vector<std::string>& args) {
+  const CLI::App* command = nullptr;
+  try {
+    // CLI11 takes a vector in reverse order.
+    app->parse(std::vector<std::string>(args.rbegin(), args.rend()));
+  } catch (const CLI::RequiredError&) {
+    // A required flag may come from the config file. CLI11 checks requirements after reading
+    // every argument, so --config is known here; the second parse checks again.
+    if (configPath(*app, &command).empty()) throw;
+  }
+  const std::string path = configPath(*app, &command);
+  if (path.empty()) return;
+  std::vector<std::string> expanded = args;
+  const auto position = afterCommandName(*command, &expanded);
+  const std::vector<std::string> from_file = configFileArguments(path, *command);
+  expanded.insert(position, from_file.begin(), from_file.end());
+  app->clear();
+  app->parse(std::vector<std::string>(expanded.rbegin(), expanded.rend()));
 }
 
 void addConfigFlag(CLI::App* command) {
@@ -83,7 +187,61 @@ void addConfigFlag(CLI::App* command) {
 nlohmann::json optionsToJson(const CLI::App& command) {
   nlohmann::json json = nlohmann::json::object();
   for (const auto& [name, value] : effectiveOptions(command)) json[name] = value;
+  // effectiveOptions() lists every value given; the one in force is the last (a flag that
+  // overrides the config file), which reduced_results() applies.
+  for (const CLI::Option* option : command.get_options()) {
+    const std::vector<std::string>& names = option->get_lnames();
+    if (names.empty() || !json.contains(names.front()) || option->count() == 0) continue;
+    if (option->get_items_expected_max() == 0) continue;
+    json[names.front()] = CLI::detail::join(option->reduced_results(), " ");
+  }
   return json;
+}
+
+nlohmann::json optimizerOptionsToJson(const OptimizerOptions& options) {
+  return {{"linear_solver", toString(options.linear_solver)},
+          {"trust_region", toString(options.trust_region)},
+          {"max_iterations", options.max_iterations},
+          {"num_threads", options.num_threads},
+          {"function_tolerance", options.function_tolerance},
+          {"gradient_tolerance", options.gradient_tolerance},
+          {"parameter_tolerance", options.parameter_tolerance},
+          {"structure_first_ordering", options.structure_first_ordering},
+          {"use_inner_iterations", options.use_inner_iterations},
+          {"verbose", options.verbose}};
+}
+
+nlohmann::json schedulerOptionsToJson(const SchedulerOptions& options) {
+  return {{"strategy", toString(options.strategy)},
+          {"scope", toString(options.scope)},
+          {"local_window", options.local_window},
+          {"max_rounds", options.max_rounds},
+          {"round_tolerance", options.round_tolerance},
+          {"fix_first_pose", options.fix_first_pose},
+          {"optimizer", optimizerOptionsToJson(options.optimizer)}};
+}
+
+nlohmann::json scheduleReportToJson(const ScheduleReport& report) {
+  nlohmann::json rounds = nlohmann::json::array();
+  for (const ScheduleRound& round : report.rounds) {
+    nlohmann::json entry = {
+        {"round", round.round}, {"phase", round.phase}, {"skipped", round.skipped}};
+    if (!round.skipped) entry["summary"] = summaryToJson(round.summary);
+    rounds.push_back(entry);
+  }
+  return {{"strategy", toString(report.strategy)},
+          {"scope", toString(report.scope)},
+          {"num_rounds", report.num_rounds},
+          {"num_factors", report.num_factors},
+          {"num_active_factors", report.num_active_factors},
+          {"initial_cost", report.initial_cost},
+          {"final_cost", report.final_cost},
+          {"total_iterations", report.total_iterations},
+          {"total_seconds", report.total_seconds},
+          {"converged", report.converged},
+          {"stop_reason", report.stop_reason},
+          {"warnings", report.warnings},
+          {"rounds", rounds}};
 }
 
 nlohmann::json summaryToJson(const OptimizationSummary& summary) {

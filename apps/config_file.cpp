@@ -11,6 +11,13 @@ namespace {
 
 bool isFlag(const CLI::Option& option) { return option.get_items_expected_max() == 0; }
 
+// What the user typed after the program name: "point-ba", or "synth planar" when nested.
+std::string commandPath(const CLI::App& command) {
+  const CLI::App* parent = command.get_parent();
+  if (!parent || !parent->get_parent()) return command.get_name();
+  return commandPath(*parent) + " " + command.get_name();
+}
+
 void appendOption(const std::string& path, const std::string& name, const YAML::Node& value,
                   const CLI::Option& option, std::vector<std::string>* args) {
   const int line = value.Mark().line + 1;
@@ -53,7 +60,7 @@ std::vector<std::string> configFileArguments(const std::string& path, const CLI:
     const CLI::Option* option = command.get_option_no_throw("--" + name);
     if (!option || name == "config" || name == "help") {
       throw ParseError(path, entry.first.Mark().line + 1,
-                       "a flag of 'curvesfm " + command.get_name() + "' (see --help)",
+                       "a flag of 'curvesfm " + commandPath(command) + "' (see --help)",
                        "'" + name + "'");
     }
     appendOption(path, name, entry.second, *option, &args);

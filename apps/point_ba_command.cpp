@@ -50,11 +50,7 @@ PointBaCommand::PointBaCommand(CLI::App* app) {
   c->add_option("--point-noise", scene_.point_noise, "Start-guess point noise (m)")
       ->capture_default_str();
   c->add_option("--seed", scene_.seed, "Random seed")->capture_default_str();
-  c->add_option("--pixel-sigma", ba_.pixel_sigma, "Reprojection sigma (px)")
-      ->capture_default_str();
-  addKernelFlag(c, "kernel", &ba_.kernel, "Robust kernel on reprojection errors");
-  c->add_option("--kernel-width", ba_.kernel_width, "Kernel width (sigmas)")
-      ->capture_default_str();
+  addMeasurementFlags(c, &ba_);
   addOptimizerFlags(c, &optimizer_);
   c->add_option("--report", report_path_, "Write a JSON report (configuration, errors, solver)");
 }

@@ -24,6 +24,7 @@
 #include "frontend/point_bundle_adjustment.h"
 #include "graph/ceres_cost_function.h"
 #include "sim/curve_scene.h"
+#include "sim/curve_scene_input.h"
 #include "sim/point_scene.h"
 
 namespace curvesfm {
@@ -97,17 +98,7 @@ struct BenchOptions {
 
 EvaluationSet curveFactorsAtTruth(const BenchOptions& options) {
   const CurveScene scene = makeCurveScene(options.curve_scene);
-  CurveBundleAdjustmentInput input;
-  input.camera = scene.camera;
-  input.cam_from_world = scene.true_cam_from_world;
-  input.curves = scene.true_curves;
-  for (const CurveKeyframe& keyframe : scene.keyframes) {
-    input.fields.push_back(std::make_shared<const NearestEdgeField>(
-        NearestEdgeField::build(keyframe.edges, keyframe.grad_x, keyframe.grad_y)));
-  }
-  for (const CurveObservation& obs : scene.observations) {
-    input.observations.push_back({obs.curve_index, obs.segment_index, obs.keyframe_index});
-  }
+  const CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene, SceneStart::kTruth);
   const CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options.curve_ba);
   const CurveSampleCounts counts = countCurveSamples(problem.graph, problem.values);
   bench::printInt("curve_samples", counts.total());

@@ -26,11 +26,12 @@
 #include <vector>
 
 #include "benchmarks/support/bench_common.h"
-#include "benchmarks/support/plot.h"
 #include "core/errors.h"
+#include "core/plot.h"
 #include "frontend/curve_bundle_adjustment.h"
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
+#include "sim/curve_scene_input.h"
 
 namespace curvesfm {
 namespace {
@@ -99,20 +100,9 @@ struct PreparedScene {
 
 PreparedScene prepare(const NamedScene& named) {
   PreparedScene prepared{named.name, makeCurveScene(named.options), {}, {}};
-  const CurveScene& scene = prepared.scene;
-  CurveBundleAdjustmentInput& input = prepared.input;
-  input.camera = scene.camera;
-  input.cam_from_world = scene.initial_cam_from_world;
-  input.curves = scene.initial_curves;
-  input.scale_distance = scene.trueScaleDistance();
-  for (const CurveKeyframe& keyframe : scene.keyframes) {
-    input.fields.push_back(std::make_shared<const NearestEdgeField>(
-        NearestEdgeField::build(keyframe.edges, keyframe.grad_x, keyframe.grad_y)));
-  }
-  for (const CurveObservation& obs : scene.observations) {
-    input.observations.push_back({obs.curve_index, obs.segment_index, obs.keyframe_index});
-  }
-  prepared.before = evaluateCurveScene(scene, input.cam_from_world, input.curves);
+  prepared.input = makeCurveBundleAdjustmentInput(prepared.scene);
+  prepared.before = evaluateCurveScene(prepared.scene, prepared.input.cam_from_world,
+                                       prepared.input.curves);
   return prepared;
 }
 

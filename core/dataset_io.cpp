@@ -10,6 +10,7 @@
 #include <limits>
 #include <locale>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <regex>
 #include <sstream>
@@ -56,6 +57,18 @@ std::ifstream openForReading(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw IoError(path, "cannot open for reading");
   return in;
+}
+
+// Opens `path`, lets write(out) fill it and reports a failed open or write as IoError.
+template <class Write>
+void writeTextFile(const std::string& path, Write&& write) {
+  std::ofstream out(path);
+  if (!out) throw IoError(path, "cannot open for writing");
+  // The global locale could otherwise turn the decimal point into a comma.
+  out.imbue(std::locale::classic());
+  write(out);
+  out.close();
+  if (!out) throw IoError(path, "write failed");
 }
 
 Fields splitFields(std::string_view line) {
@@ -277,25 +290,65 @@ std::vector<StampedPose> readTrajectory(const std::string& path) {
   return poses;
 }
 
-void writeTrajectory(const std::string& path, const std::vector<StampedPose>& poses) {
-  std::ofstream out(path);
-  if (!out) throw IoError(path, "cannot open for writing");
-  // The global locale could otherwise turn the decimal point into a comma.
-  out.imbue(std::locale::classic());
-  out << std::fixed;
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    const StampedPose& pose = poses[i];
-    const Eigen::Vector3d& t = pose.world_from_cam.translation();
-    const Eigen::Quaterniond& q = pose.world_from_cam.rotation();
-    // "nan" would be written silently and then rejected by every reader.
-    CURVESFM_CHECK(std::isfinite(pose.timestamp) && t.allFinite() && q.coeffs().allFinite())
-        << "pose " << i << " of the trajectory for " << path << " is not finite";
-    out << std::setprecision(6) << pose.timestamp << std::setprecision(9) << ' ' << t.x() << ' '
-        << t.y() << ' ' << t.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w()
-        << '\n';
+void writeImageList(const std::string& rgb_txt_path, const std::vector<ImageEntry>& entries) {
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const std::string& path = entries[i].path;
+    // readImageList() splits at blanks and skips lines that start with '#'.
+    CURVESFM_CHECK(std::isfinite(entries[i].timestamp) && !path.empty() && path.front() != '#' &&
+                   path.find_first_of(" \t\r\n\v\f") == std::string::npos)
+        << "entry " << i << " of the image list for " << rgb_txt_path << " (\"" << path
+        << "\") cannot be read back";
   }
-  out.close();
-  if (!out) throw IoError(path, "write failed");
+  writeTextFile(rgb_txt_path, [&](std::ostream& out) {
+    out << "# color images\n# timestamp filename\n" << std::fixed << std::setprecision(6);
+    for (const ImageEntry& entry : entries) out << entry.timestamp << ' ' << entry.path << '\n';
+  });
+}
+
+cv::Mat readColorImage(const std::string& path) {
+  std::error_code ignored;
+  const std::filesystem::file_status status = std::filesystem::status(path, ignored);
+  if (!std::filesystem::exists(status)) throw IoError(path, "no such file");
+  if (std::filesystem::is_directory(status)) throw IoError(path, "is a directory");
+  cv::Mat image;
+  try {
+    image = cv::imread(path, cv::IMREAD_COLOR);
+  } catch (const cv::Exception& e) {
+    throw IoError(path, "cannot decode as an image: " + e.err);
+  }
+  if (image.empty()) {
+    throw IoError(path,
+                  "cannot decode as an image (unreadable, corrupt or not a format OpenCV "
+                  "reads)");
+  }
+  return image;
+}
+
+void writeImage(const std::string& path, const cv::Mat& image) {
+  bool written = false;
+  try {
+    written = cv::imwrite(path, image);
+  } catch (const cv::Exception& e) {
+    throw IoError(path, "cannot write the image: " + e.err);
+  }
+  if (!written) throw IoError(path, "cannot write the image");
+}
+
+void writeTrajectory(const std::string& path, const std::vector<StampedPose>& poses) {
+  writeTextFile(path, [&](std::ostream& out) {
+    out << std::fixed;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      const StampedPose& pose = poses[i];
+      const Eigen::Vector3d& t = pose.world_from_cam.translation();
+      const Eigen::Quaterniond& q = pose.world_from_cam.rotation();
+      // "nan" would be written silently and then rejected by every reader.
+      CURVESFM_CHECK(std::isfinite(pose.timestamp) && t.allFinite() && q.coeffs().allFinite())
+          << "pose " << i << " of the trajectory for " << path << " is not finite";
+      out << std::setprecision(6) << pose.timestamp << std::setprecision(9) << ' ' << t.x() << ' '
+          << t.y() << ' ' << t.z() << ' ' << q.x() << ' ' << q.y() << ' ' << q.z() << ' ' << q.w()
+          << '\n';
+    }
+  });
 }
 
 Camera readCameraYaml(const std::string& path) {
@@ -321,6 +374,20 @@ Camera readCameraYaml(const std::string& path) {
   intrinsics.width = file.pixelCount("Camera.width");
   intrinsics.height = file.pixelCount("Camera.height");
   return Camera(intrinsics);
+}
+
+void writeCameraYaml(const std::string& path, const Camera& camera) {
+  const CameraIntrinsics& c = camera.intrinsics();
+  writeTextFile(path, [&](std::ostream& out) {
+    // max_digits10 makes every double round-trip; whole numbers print without a point, which
+    // OpenCV reads as integers and readCameraYaml() accepts as numbers.
+    out << std::setprecision(std::numeric_limits<double>::max_digits10);
+    out << "%YAML:1.0\n\n# Pinhole camera with radial-tangential distortion (OpenCV model)\n"
+        << "Camera.fx: " << c.fx << "\nCamera.fy: " << c.fy << "\nCamera.cx: " << c.cx
+        << "\nCamera.cy: " << c.cy << "\n\nCamera.k1: " << c.k1 << "\nCamera.k2: " << c.k2
+        << "\nCamera.p1: " << c.p1 << "\nCamera.p2: " << c.p2 << "\nCamera.k3: " << c.k3
+        << "\n\nCamera.width: " << c.width << "\nCamera.height: " << c.height << "\n";
+  });
 }
 
 }  // namespace curvesfm

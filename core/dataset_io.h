@@ -1,5 +1,6 @@
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,22 @@ struct ImageEntry {
 /// holding `rgb_txt_path`; absolute paths are kept. Entries keep the file's order. Paths must not
 /// contain blanks. A list with no entries is a ParseError (line 0).
 std::vector<ImageEntry> readImageList(const std::string& rgb_txt_path);
+
+/// Writes a TUM image list: a "# timestamp filename" header, then one line "timestamp path" per
+/// entry in the given order, the timestamp with 6 decimals as writeTrajectory() writes it (so the
+/// two files of a dataset carry identical timestamps). Paths are written as given: make them
+/// relative to the list's folder, as readImageList() resolves them. A path that is empty or
+/// holds a blank cannot be read back: CheckError. Throws IoError if the file cannot be written.
+void writeImageList(const std::string& rgb_txt_path, const std::vector<ImageEntry>& entries);
+
+/// Reads an image as 8-bit, 3-channel BGR (cv::IMREAD_COLOR: grey is expanded, alpha dropped).
+/// Throws IoError "<path>: no such file", "<path>: is a directory" or "<path>: cannot decode as
+/// an image ...".
+cv::Mat readColorImage(const std::string& path);
+
+/// Writes `image` in the format its file extension names (cv::imwrite; PNG is lossless).
+/// Throws IoError naming the path if OpenCV has no writer for the extension or the write fails.
+void writeImage(const std::string& path, const cv::Mat& image);
 
 /// A timestamped camera pose.
 struct StampedPose {
@@ -60,5 +77,11 @@ void writeTrajectory(const std::string& path, const std::vector<StampedPose>& po
 /// line OpenCV reports and its message), for a missing required key (line 0), and for a value
 /// that is not a finite number or out of range (with the key's line when it can be located).
 Camera readCameraYaml(const std::string& path);
+
+/// Writes `camera` as OpenCV FileStorage YAML ("%YAML:1.0" header) with every key that
+/// readCameraYaml() reads, distortion included; numbers with 17 significant digits, so that
+/// reading the file back gives the same intrinsics exactly. Throws IoError if the file cannot be
+/// written.
+void writeCameraYaml(const std::string& path, const Camera& camera);
 
 }  // namespace curvesfm

@@ -71,6 +71,15 @@ class NearestEdgeField {
     return nearestToPixel(static_cast<int>(x + 0.5), static_cast<int>(y + 0.5));
   }
 
+  /// A hint that nearest(x, y) is coming: starts loading its cache line, so that a caller with
+  /// other work to do meanwhile does not wait for the miss. No effect outside the image.
+  void prefetch(double x, double y) const {
+    if (contains(x, y)) {
+      __builtin_prefetch(&index_[static_cast<std::size_t>(static_cast<int>(y + 0.5)) * width_ +
+                                 static_cast<int>(x + 0.5)]);
+    }
+  }
+
   /// True if (x, y) rounds to a pixel of the image, i.e. lies in (-0.5, width - 0.5) x
   /// (-0.5, height - 0.5); false for non-finite coordinates.
   bool contains(double x, double y) const {

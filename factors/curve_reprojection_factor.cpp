@@ -1,37 +1,23 @@
 #include "factors/curve_reprojection_factor.h"
 
 #include <array>
+#include <cmath>
 
-#include "core/bezier.h"
 #include "core/check.h"
 
 namespace curvesfm {
 namespace {
 
-enum class SampleOutcome { kOnField, kBehindCamera, kOutsideImage, kBeyondReach };
-
-// The nearest edge of one projected sample, or why there is none.
-struct SampleHit {
-  SampleOutcome outcome = SampleOutcome::kOnField;
-  const EdgePixel* edge = nullptr;
+enum class SampleOutcome {
+  kOnField,
+  kBehindCamera,
+  kOutsideImage,
+  kBeyondReach,
+  kWrongOrientation
 };
 
-SampleHit locateSample(const Camera& camera, const NearestEdgeField& field,
-                       const Eigen::Vector3d& point_in_cam, Eigen::Vector2d* pixel,
-                       Matrix23d* d_pixel_d_cam) {
-  if (!camera.project(point_in_cam, pixel, d_pixel_d_cam)) {
-    return {SampleOutcome::kBehindCamera, nullptr};
-  }
-  const EdgePixel* edge = field.nearest((*pixel)[0], (*pixel)[1]);
-  if (edge) return {SampleOutcome::kOnField, edge};
-  return {field.contains((*pixel)[0], (*pixel)[1]) ? SampleOutcome::kBeyondReach
-                                                   : SampleOutcome::kOutsideImage,
-          nullptr};
-}
-
 BezierSegmentParams segmentParams(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
-                                  const Direction& v0, const Direction& v1, double d1,
-                                  double d2) {
+                                  const Direction& v0, const Direction& v1, double d1, double d2) {
   BezierSegmentParams params;
   params.q0 = q0;
   params.q1 = q1;
@@ -44,29 +30,97 @@ BezierSegmentParams segmentParams(const Eigen::Vector3d& q0, const Eigen::Vector
 
 }  // namespace
 
+CurveSampling::CurveSampling(int num_samples, bool use_subpixel_edges, double max_normal_angle_deg)
+    : point_weights(4, num_samples),
+      tangent_weights(4, num_samples),
+      use_subpixel_edges(use_subpixel_edges),
+      max_normal_angle_deg(max_normal_angle_deg),
+      sin_max_normal_angle(std::sin(max_normal_angle_deg * M_PI / 180.0)) {
+  CURVESFM_CHECK(num_samples >= 2 && num_samples <= CurveReprojectionFactor::kMaxSamples)
+      << "CurveSampling: " << num_samples << " samples, expected 2.."
+      << CurveReprojectionFactor::kMaxSamples;
+  CURVESFM_CHECK(max_normal_angle_deg > 0.0 && max_normal_angle_deg <= 90.0)
+      << "CurveSampling: max_normal_angle_deg " << max_normal_angle_deg << ", expected (0, 90]";
+  point_weights = uniformBernsteinWeights(num_samples);
+  for (int k = 0; k < num_samples; ++k) {
+    const double t = static_cast<double>(k) / (num_samples - 1);
+    tangent_weights.col(k) = bernsteinDerivativeWeights(t);
+  }
+}
+
 CurveSampleCounts& CurveSampleCounts::operator+=(const CurveSampleCounts& other) {
   on_field += other.on_field;
   behind_camera += other.behind_camera;
   outside_image += other.outside_image;
   beyond_reach += other.beyond_reach;
+  wrong_orientation += other.wrong_orientation;
   return *this;
 }
 
-CurveReprojectionFactor::CurveReprojectionFactor(
-    Key pose_key, const SegmentKeys& segment, std::shared_ptr<const NearestEdgeField> field,
-    std::shared_ptr<const Camera> camera, std::shared_ptr<const Eigen::Matrix4Xd> sample_weights,
-    bool use_subpixel_edges, NoiseModel noise_model)
+CurveReprojectionFactor::CurveReprojectionFactor(Key pose_key, const SegmentKeys& segment,
+                                                 std::shared_ptr<const NearestEdgeField> field,
+                                                 std::shared_ptr<const Camera> camera,
+                                                 std::shared_ptr<const CurveSampling> sampling,
+                                                 NoiseModel noise_model)
     : Base({pose_key, segment.q0, segment.q1, segment.v0, segment.v1, segment.d1, segment.d2},
-           std::move(noise_model), sample_weights ? static_cast<int>(sample_weights->cols()) : 0),
+           std::move(noise_model), sampling ? sampling->numSamples() : 0),
       field_(std::move(field)),
       camera_(std::move(camera)),
-      weights_(std::move(sample_weights)),
-      use_subpixel_edges_(use_subpixel_edges) {
-  CURVESFM_CHECK(field_ && camera_ && weights_)
-      << "CurveReprojectionFactor needs a field, a camera and sample weights";
-  CURVESFM_CHECK(weights_->cols() >= 1 && weights_->cols() <= kMaxSamples)
-      << "CurveReprojectionFactor: " << weights_->cols() << " samples, expected 1.."
-      << kMaxSamples;
+      sampling_(std::move(sampling)) {
+  CURVESFM_CHECK(field_ && camera_ && sampling_)
+      << "CurveReprojectionFactor needs a field, a camera and a sampling";
+}
+
+// Per-sample intermediate results of one evaluation, on the stack.
+struct CurveReprojectionFactor::SampleBatch {
+  std::array<Eigen::Vector3d, kMaxSamples> rotated;  // R * B(t_k)
+  std::array<Eigen::Vector2d, kMaxSamples> pixel;
+  std::array<Matrix23d, kMaxSamples> d_pixel_d_cam;
+  std::array<const EdgePixel*, kMaxSamples> edge;  // null unless kOnField
+  std::array<SampleOutcome, kMaxSamples> outcome;
+};
+
+void CurveReprojectionFactor::locateSamples(const Pose3& cam_from_world, const Eigen::Matrix3d& R,
+                                            const SegmentEvaluator& segment, bool with_jacobians,
+                                            SampleBatch* batch) const {
+  // Three passes: projections, then field look-ups, then the orientation check. The look-ups
+  // are independent cache misses into a field of about a megabyte per keyframe; in a loop of
+  // their own the CPU overlaps them instead of waiting for each in turn (this halves the cost
+  // per sample, see curve_factor_bench).
+  const int num_samples = numSamples();
+  const bool check_orientation = sampling_->sin_max_normal_angle < 1.0;
+  SampleBatch& b = *batch;
+  for (int k = 0; k < num_samples; ++k) {
+    b.rotated[k] = R * segment.evaluate(sampling_->point_weights.col(k));
+    const bool in_front =
+        camera_->project(b.rotated[k] + cam_from_world.translation(), &b.pixel[k],
+                         with_jacobians || check_orientation ? &b.d_pixel_d_cam[k] : nullptr);
+    b.outcome[k] = in_front ? SampleOutcome::kOnField : SampleOutcome::kBehindCamera;
+    if (in_front) field_->prefetch(b.pixel[k][0], b.pixel[k][1]);
+  }
+  for (int k = 0; k < num_samples; ++k) {
+    b.edge[k] = b.outcome[k] == SampleOutcome::kOnField
+                    ? field_->nearest(b.pixel[k][0], b.pixel[k][1])
+                    : nullptr;
+    __builtin_prefetch(b.edge[k]);
+  }
+  for (int k = 0; k < num_samples; ++k) {
+    if (b.outcome[k] != SampleOutcome::kOnField) continue;
+    if (!b.edge[k]) {
+      b.outcome[k] = field_->contains(b.pixel[k][0], b.pixel[k][1]) ? SampleOutcome::kBeyondReach
+                                                                    : SampleOutcome::kOutsideImage;
+      continue;
+    }
+    if (!check_orientation) continue;
+    // The edge normal must be (nearly) normal to the projected tangent t: |g . t| <= sin * |t|.
+    const Eigen::Vector2d tangent =
+        b.d_pixel_d_cam[k] * (R * segment.evaluate(sampling_->tangent_weights.col(k)));
+    if (std::abs(b.edge[k]->normal.cast<double>().dot(tangent)) >
+        sampling_->sin_max_normal_angle * tangent.norm()) {
+      b.outcome[k] = SampleOutcome::kWrongOrientation;
+      b.edge[k] = nullptr;
+    }
+  }
 }
 
 CurveReprojectionFactor::Error CurveReprojectionFactor::evaluateError(
@@ -86,31 +140,16 @@ CurveReprojectionFactor::Error CurveReprojectionFactor::evaluateError(
   if (H_d1) H_d1->resize(num_samples);
   if (H_d2) H_d2->resize(num_samples);
 
-  // Three passes: projections, then field look-ups, then residuals and Jacobians. The
-  // look-ups are independent cache misses into a field of about a megabyte per keyframe; in a
-  // loop of their own the CPU overlaps them instead of waiting for each in turn (this halves
-  // the cost per sample, see curve_factor_bench).
   const Eigen::Matrix3d R = cam_from_world.rotationMatrix();
   const SegmentEvaluator segment(segmentParams(q0, q1, v0, v1, d1, d2));
-  std::array<Eigen::Vector3d, kMaxSamples> rotated;
-  std::array<Eigen::Vector2d, kMaxSamples> pixel;
-  std::array<Matrix23d, kMaxSamples> d_pixel_d_cam;
-  std::array<bool, kMaxSamples> in_front;
-  for (int k = 0; k < num_samples; ++k) {
-    rotated[k] = R * segment.evaluate(weights_->col(k));
-    in_front[k] = camera_->project(rotated[k] + cam_from_world.translation(), &pixel[k],
-                                   wants_jacobians ? &d_pixel_d_cam[k] : nullptr);
-  }
-  std::array<const EdgePixel*, kMaxSamples> edge;
-  for (int k = 0; k < num_samples; ++k) {
-    edge[k] = in_front[k] ? field_->nearest(pixel[k][0], pixel[k][1]) : nullptr;
-    __builtin_prefetch(edge[k]);
-  }
+  SampleBatch batch;
+  locateSamples(cam_from_world, R, segment, wants_jacobians, &batch);
 
   Error error(num_samples);
   SegmentJacobians d_B;
   for (int k = 0; k < num_samples; ++k) {
-    if (!edge[k]) {
+    const EdgePixel* edge = batch.edge[k];
+    if (!edge) {
       error[k] = cappedResidual();
       if (H_pose) H_pose->row(k).setZero();
       if (H_q0) H_q0->row(k).setZero();
@@ -121,18 +160,18 @@ CurveReprojectionFactor::Error CurveReprojectionFactor::evaluateError(
       if (H_d2) (*H_d2)[k] = 0.0;
       continue;
     }
-    const Eigen::Vector2d normal = edge[k]->normal.cast<double>();
+    const Eigen::Vector2d normal = edge->normal.cast<double>();
     const Eigen::Vector2d edge_position =
-        (use_subpixel_edges_ ? edge[k]->subpixel : edge[k]->pixel).cast<double>();
-    error[k] = (pixel[k] - edge_position).dot(normal);
+        (sampling_->use_subpixel_edges ? edge->subpixel : edge->pixel).cast<double>();
+    error[k] = (batch.pixel[k] - edge_position).dot(normal);
     if (!wants_jacobians) continue;
 
-    segment.evaluate(weights_->col(k), &d_B);
-    const Eigen::RowVector3d d_r_d_cam = normal.transpose() * d_pixel_d_cam[k];
+    segment.evaluate(sampling_->point_weights.col(k), &d_B);
+    const Eigen::RowVector3d d_r_d_cam = normal.transpose() * batch.d_pixel_d_cam[k];
     const Eigen::RowVector3d d_r_d_point = d_r_d_cam * R;
     if (H_pose) {
       // d(exp(w) R p + t + u)/d[w; u] = [-[R p]x, I], and -a^T [b]x = (b x a)^T.
-      H_pose->row(k).head<3>() = rotated[k].cross(d_r_d_cam.transpose()).transpose();
+      H_pose->row(k).head<3>() = batch.rotated[k].cross(d_r_d_cam.transpose()).transpose();
       H_pose->row(k).tail<3>() = d_r_d_cam;
     }
     if (H_q0) H_q0->row(k) = d_B.scale_q0 * d_r_d_point;
@@ -147,19 +186,30 @@ CurveReprojectionFactor::Error CurveReprojectionFactor::evaluateError(
 
 CurveSampleCounts CurveReprojectionFactor::sampleCounts(const Values& values) const {
   const Pose3& cam_from_world = values.at<Pose3>(keys()[0]);
-  const SegmentEvaluator segment(segmentParams(
-      values.at<Eigen::Vector3d>(keys()[1]), values.at<Eigen::Vector3d>(keys()[2]),
-      values.at<Direction>(keys()[3]), values.at<Direction>(keys()[4]),
-      values.at<double>(keys()[5]), values.at<double>(keys()[6])));
+  const SegmentEvaluator segment(
+      segmentParams(values.at<Eigen::Vector3d>(keys()[1]), values.at<Eigen::Vector3d>(keys()[2]),
+                    values.at<Direction>(keys()[3]), values.at<Direction>(keys()[4]),
+                    values.at<double>(keys()[5]), values.at<double>(keys()[6])));
+  SampleBatch batch;
+  locateSamples(cam_from_world, cam_from_world.rotationMatrix(), segment, false, &batch);
   CurveSampleCounts counts;
-  Eigen::Vector2d pixel;
   for (int k = 0; k < numSamples(); ++k) {
-    const Eigen::Vector3d point_in_cam = cam_from_world * segment.evaluate(weights_->col(k));
-    switch (locateSample(*camera_, *field_, point_in_cam, &pixel, nullptr).outcome) {
-      case SampleOutcome::kOnField: ++counts.on_field; break;
-      case SampleOutcome::kBehindCamera: ++counts.behind_camera; break;
-      case SampleOutcome::kOutsideImage: ++counts.outside_image; break;
-      case SampleOutcome::kBeyondReach: ++counts.beyond_reach; break;
+    switch (batch.outcome[k]) {
+      case SampleOutcome::kOnField:
+        ++counts.on_field;
+        break;
+      case SampleOutcome::kBehindCamera:
+        ++counts.behind_camera;
+        break;
+      case SampleOutcome::kOutsideImage:
+        ++counts.outside_image;
+        break;
+      case SampleOutcome::kBeyondReach:
+        ++counts.beyond_reach;
+        break;
+      case SampleOutcome::kWrongOrientation:
+        ++counts.wrong_orientation;
+        break;
     }
   }
   return counts;

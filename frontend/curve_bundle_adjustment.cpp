@@ -73,6 +73,10 @@ void CurveBundleAdjustmentOptions::validate() const {
       throw InvalidOptions(name, field, std::to_string(value), "must be >= 0 and finite");
     }
   };
+  if (!(max_normal_angle_deg > 0.0 && max_normal_angle_deg <= 90.0)) {
+    throw InvalidOptions(name, "max_normal_angle_deg", std::to_string(max_normal_angle_deg),
+                         "must be in (0, 90]");
+  }
   positive(pixel_sigma, "pixel_sigma");
   positive(kernel_width, "kernel_width");
   non_negative(lambda1, "lambda1");
@@ -93,8 +97,8 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
     addRegularisers(static_cast<std::uint32_t>(c), input.curves[c], options, &problem.graph);
   }
 
-  const auto weights = std::make_shared<const Eigen::Matrix4Xd>(
-      uniformBernsteinWeights(options.samples_per_segment + 1));
+  const auto sampling = std::make_shared<const CurveSampling>(
+      options.samples_per_segment + 1, options.use_subpixel_edges, options.max_normal_angle_deg);
   const NoiseModel pixel_noise{options.pixel_sigma,
                                RobustKernel(options.kernel, options.kernel_width)};
   const int num_curves = static_cast<int>(input.curves.size());
@@ -107,7 +111,7 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
         << num_keyframes << " keyframes)";
     problem.graph.emplace<CurveReprojectionFactor>(
         poseKey(obs.keyframe), segmentKeys(obs.curve, obs.segment), input.fields[obs.keyframe],
-        input.camera, weights, options.use_subpixel_edges, pixel_noise);
+        input.camera, sampling, pixel_noise);
   }
 
   if (options.fix_first_pose && num_keyframes > 0) problem.config.setConstant(poseKey(0));

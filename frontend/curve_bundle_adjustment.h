@@ -26,6 +26,11 @@ struct CurveBundleAdjustmentOptions {
   int samples_per_segment = 10;
   /// Measure against the nearest edge pixel's sub-pixel position (true) or its pixel centre.
   bool use_subpixel_edges = true;
+  /// Match a sample only to an edge whose normal lies within this angle (deg) of the projected
+  /// curve's normal (CurveSampling::max_normal_angle_deg); (0, 90], 90 accepts every match.
+  /// Lower values remove most of the bias of partly hidden curves but cap more samples of a
+  /// poor start (docs/benchmarks.md, "Curve bundle adjustment").
+  double max_normal_angle_deg = 90.0;
   double pixel_sigma = 1.0;  ///< Std dev of an edge residual (px); > 0.
   RobustKernelType kernel = RobustKernelType::kHuber;  ///< Kernel on edge residuals.
   double kernel_width = 2.0;  ///< Kernel width in sigmas (px at sigma 1); > 0.

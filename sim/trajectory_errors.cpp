@@ -1,6 +1,5 @@
 #include "sim/trajectory_errors.h"
 
-#include <Eigen/Geometry>
 #include <cmath>
 
 #include "core/check.h"
@@ -34,23 +33,13 @@ Eigen::Matrix3Xd cameraFramePoints(const std::vector<Pose3>& cam_from_world, dou
   return points;
 }
 
-Sim3 umeyamaSim3(const Eigen::Matrix3Xd& estimated, const Eigen::Matrix3Xd& truth) {
-  const Eigen::Matrix4d transform = Eigen::umeyama(estimated, truth, true);
-  Sim3 sim3;
-  // The top-left block is scale * R; R has unit-norm columns.
-  sim3.scale = transform.topLeftCorner<3, 3>().col(0).norm();
-  sim3.rotation = transform.topLeftCorner<3, 3>() / sim3.scale;
-  sim3.translation = transform.topRightCorner<3, 1>();
-  return sim3;
-}
-
 }  // namespace
 
 Sim3 alignCameraCentres(const std::vector<Pose3>& true_cam_from_world,
                         const std::vector<Pose3>& estimated_cam_from_world) {
   checkSameSize(true_cam_from_world, estimated_cam_from_world);
-  return umeyamaSim3(cameraFramePoints(estimated_cam_from_world, 0.0),
-                     cameraFramePoints(true_cam_from_world, 0.0));
+  return alignPointSets(cameraFramePoints(estimated_cam_from_world, 0.0),
+                        cameraFramePoints(true_cam_from_world, 0.0), AlignmentKind::kSim3);
 }
 
 Sim3 alignCameraFrames(const std::vector<Pose3>& true_cam_from_world,
@@ -60,8 +49,8 @@ Sim3 alignCameraFrames(const std::vector<Pose3>& true_cam_from_world,
   // The estimate's axes are drawn at the length that the centres' scale maps to axis_length,
   // so that an exact similarity between the trajectories is recovered exactly.
   const double scale = alignCameraCentres(true_cam_from_world, estimated_cam_from_world).scale;
-  return umeyamaSim3(cameraFramePoints(estimated_cam_from_world, axis_length / scale),
-                     cameraFramePoints(true_cam_from_world, axis_length));
+  return alignPointSets(cameraFramePoints(estimated_cam_from_world, axis_length / scale),
+                        cameraFramePoints(true_cam_from_world, axis_length), AlignmentKind::kSim3);
 }
 
 TrajectoryErrors evaluateTrajectory(const std::vector<Pose3>& true_cam_from_world,

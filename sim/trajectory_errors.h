@@ -4,20 +4,9 @@
 #include <vector>
 
 #include "core/pose3.h"
+#include "core/similarity_alignment.h"
 
 namespace curvesfm {
-
-/// A similarity transform x_target = scale * rotation * x_source + translation, e.g. the
-/// alignment truth_from_estimated of an estimated (gauge-free up to Sim(3)) reconstruction.
-struct Sim3 {
-  double scale = 1.0;                                      ///< > 0, unitless.
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  ///< A rotation matrix.
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();   ///< In the target frame's unit.
-
-  Eigen::Vector3d operator*(const Eigen::Vector3d& point) const {
-    return scale * (rotation * point) + translation;
-  }
-};
 
 /// The Umeyama (least-squares, with scale) Sim(3) truth_from_estimated that maps the estimated
 /// camera centres onto the true ones. Both trajectories are cam_from_world, index-aligned, and

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <opencv2/core.hpp>
 #include <random>
 #include <sstream>
 #include <string>
@@ -331,6 +332,72 @@ TEST_F(DatasetIoTest, ReadCameraYamlSequenceRootIsParseError) {
   const std::string path = write("camera.yaml", "%YAML:1.0\n- 1\n- 2\n");
   EXPECT_EQ(errorMessage<ParseError>([&] { readCameraYaml(path); }),
             "ParseError: " + path + ": expected a YAML mapping of Camera.* keys, found a sequence");
+}
+
+TEST_F(DatasetIoTest, WriteCameraYamlRoundTripsExactly) {
+  // Values with no short decimal form, and an exponent, which OpenCV's parser must accept.
+  CameraIntrinsics intrinsics;
+  intrinsics.fx = 517.306408 + 1.0 / 3.0;
+  intrinsics.k1 = 0.262383;
+  intrinsics.k2 = -0.953104;
+  intrinsics.p1 = -0.005358;
+  intrinsics.p2 = 1e-7;
+  intrinsics.k3 = 1.163314;
+  intrinsics.width = 641;
+  intrinsics.height = 479;
+  const std::string path = (folder_ / "camera.yaml").string();
+  writeCameraYaml(path, Camera(intrinsics));
+  const CameraIntrinsics back = readCameraYaml(path).intrinsics();
+  EXPECT_EQ(back.fx, intrinsics.fx);
+  EXPECT_EQ(back.fy, intrinsics.fy);
+  EXPECT_EQ(back.cx, intrinsics.cx);
+  EXPECT_EQ(back.cy, intrinsics.cy);
+  EXPECT_EQ(back.k1, intrinsics.k1);
+  EXPECT_EQ(back.k2, intrinsics.k2);
+  EXPECT_EQ(back.p1, intrinsics.p1);
+  EXPECT_EQ(back.p2, intrinsics.p2);
+  EXPECT_EQ(back.k3, intrinsics.k3);
+  EXPECT_EQ(back.width, 641);
+  EXPECT_EQ(back.height, 479);
+  EXPECT_THAT(read(path), HasSubstr("%YAML:1.0\n"));
+}
+
+TEST_F(DatasetIoTest, WriteCameraYamlToMissingFolderIsIoError) {
+  const std::string path = (folder_ / "no_such_folder" / "camera.yaml").string();
+  EXPECT_EQ(errorMessage<IoError>([&] { writeCameraYaml(path, Camera(CameraIntrinsics{})); }),
+            "IoError: " + path + ": cannot open for writing");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Images
+
+TEST_F(DatasetIoTest, WriteImageListRoundTripsWithRelativePaths) {
+  const std::string path = (folder_ / "rgb.txt").string();
+  writeImageList(path, {{0.0, "rgb/000000.png"}, {1.0 / 30.0, "rgb/000001.png"}});
+  const std::vector<ImageEntry> entries = readImageList(path);
+  ASSERT_EQ(entries.size(), 2u);
+  EXPECT_EQ(entries[0].timestamp, 0.0);
+  EXPECT_EQ(entries[1].timestamp, 0.033333);  // 6 decimals, as writeTrajectory
+  EXPECT_EQ(entries[1].path, (folder_ / "rgb/000001.png").string());
+  EXPECT_THROW(writeImageList(path, {{0.0, "a b.png"}}), CheckError);
+}
+
+TEST_F(DatasetIoTest, ImageWriteReadRoundTripsAndErrorsNameThePath) {
+  cv::Mat image(4, 5, CV_8UC3, cv::Scalar(10, 20, 30));
+  image.at<cv::Vec3b>(1, 2) = cv::Vec3b(200, 100, 0);
+  const std::string path = (folder_ / "image.png").string();
+  writeImage(path, image);
+  EXPECT_EQ(cv::norm(readColorImage(path), image, cv::NORM_INF), 0.0);
+
+  const std::string missing = (folder_ / "missing.png").string();
+  EXPECT_EQ(errorMessage<IoError>([&] { readColorImage(missing); }),
+            "IoError: " + missing + ": no such file");
+  const std::string text = write("not_an_image.png", "hello");
+  EXPECT_THAT(errorMessage<IoError>([&] { readColorImage(text); }),
+              HasSubstr("IoError: " + text + ": cannot decode as an image"));
+  const std::string unwritable = (folder_ / "no_such_folder" / "image.png").string();
+  EXPECT_THAT(errorMessage<IoError>([&] { writeImage(unwritable, image); }),
+              HasSubstr("IoError: " + unwritable + ": cannot write the image"));
 }
 
 }  // namespace

@@ -27,10 +27,6 @@ std::shared_ptr<const Camera> distortedCamera() {
       CameraIntrinsics{520.0, 515.0, 320.5, 240.5, -0.12, 0.05, 1e-3, -2e-3, 0.01, kWidth, kHeight});
 }
 
-std::shared_ptr<const Eigen::Matrix4Xd> sampleWeights(int num_samples) {
-  return std::make_shared<const Eigen::Matrix4Xd>(uniformBernsteinWeights(num_samples));
-}
-
 // A vertical edge along image column `column` whose gradient magnitude across it is
 // `left, centre, right` at columns column-1, column, column+1 (pointing +x).
 std::shared_ptr<const NearestEdgeField> verticalEdgeField(int column, float left = 1.0f,
@@ -97,9 +93,11 @@ Values randomConfiguration(std::mt19937& rng) {
 
 CurveReprojectionFactor makeFactor(std::shared_ptr<const NearestEdgeField> field,
                                    std::shared_ptr<const Camera> camera, int num_samples = 11,
-                                   bool subpixel = true) {
-  return CurveReprojectionFactor(poseKey(0), kSegment, std::move(field), std::move(camera),
-                                 sampleWeights(num_samples), subpixel, NoiseModel{});
+                                   bool subpixel = true, double max_normal_angle_deg = 90.0) {
+  return CurveReprojectionFactor(
+      poseKey(0), kSegment, std::move(field), std::move(camera),
+      std::make_shared<const CurveSampling>(num_samples, subpixel, max_normal_angle_deg),
+      NoiseModel{});
 }
 
 TEST(CurveReprojectionFactor, ZeroOnTheEdgeAndSignedPixelDistanceOffIt) {
@@ -248,15 +246,41 @@ TEST(CurveReprojectionFactor, PartlyVisibleSegmentMixesLiveAndCappedRows) {
   testing::expectJacobiansMatchNumerical(factor, values, 1e-5);
 }
 
-TEST(CurveReprojectionFactor, RejectsMissingInputsAndBadSampleCounts) {
+TEST(CurveReprojectionFactor, RejectsMissingInputsAndBadSampling) {
   const auto field = verticalEdgeField(420);
   EXPECT_THROW(CurveReprojectionFactor(poseKey(0), kSegment, nullptr, pinholeCamera(),
-                                       sampleWeights(5), true, NoiseModel{}),
+                                       std::make_shared<const CurveSampling>(5, true),
+                                       NoiseModel{}),
                CheckError);
-  EXPECT_THROW(CurveReprojectionFactor(poseKey(0), kSegment, field, pinholeCamera(),
-                                       sampleWeights(CurveReprojectionFactor::kMaxSamples + 1),
-                                       true, NoiseModel{}),
+  EXPECT_THROW(CurveReprojectionFactor(poseKey(0), kSegment, field, pinholeCamera(), nullptr,
+                                       NoiseModel{}),
                CheckError);
+  EXPECT_THROW(CurveSampling(CurveReprojectionFactor::kMaxSamples + 1, true), CheckError);
+  EXPECT_THROW(CurveSampling(1, true), CheckError);
+  EXPECT_THROW(CurveSampling(11, true, 0.0), CheckError);
+  EXPECT_THROW(CurveSampling(11, true, 91.0), CheckError);
+}
+
+TEST(CurveReprojectionFactor, OrientationCheckCapsSamplesOnEdgesAlongTheCurve) {
+  // A horizontal segment just beside a vertical edge: its samples find the edge within reach,
+  // but the edge normal (+x) runs along the projected curve, so with the check they are capped.
+  Values values = straightSegment(0.4);  // camera at the origin
+  values.update(kSegment.q0, Eigen::Vector3d(0.38, 0.0, 2.0));
+  values.update(kSegment.q1, Eigen::Vector3d(0.42, 0.0, 2.0));
+  values.update(kSegment.v0, Direction(Eigen::Vector3d::UnitX()));
+  values.update(kSegment.v1, Direction(Eigen::Vector3d::UnitX()));
+  values.update(kSegment.d1, 0.01);
+  values.update(kSegment.d2, 0.01);
+
+  const auto field = verticalEdgeField(420);
+  const CurveSampleCounts unchecked = makeFactor(field, pinholeCamera()).sampleCounts(values);
+  EXPECT_EQ(unchecked.on_field, 11);
+  const auto checked = makeFactor(field, pinholeCamera(), 11, true, 45.0);
+  const CurveSampleCounts counts = checked.sampleCounts(values);
+  EXPECT_EQ(counts.wrong_orientation, 11);
+  EXPECT_TRUE(checked.unwhitenedError(values).isConstant(checked.cappedResidual()));
+  // The same check passes a segment that runs along the edge.
+  EXPECT_EQ(checked.sampleCounts(straightSegment(0.4)).on_field, 11);
 }
 
 }  // namespace

@@ -9,25 +9,10 @@
 
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
+#include "sim/curve_scene_input.h"
 
 namespace curvesfm {
 namespace {
-
-CurveBundleAdjustmentInput startingGuess(const CurveScene& scene) {
-  CurveBundleAdjustmentInput input;
-  input.camera = scene.camera;
-  input.cam_from_world = scene.initial_cam_from_world;
-  input.curves = scene.initial_curves;
-  input.scale_distance = scene.trueScaleDistance();
-  for (const CurveKeyframe& keyframe : scene.keyframes) {
-    input.fields.push_back(std::make_shared<const NearestEdgeField>(
-        NearestEdgeField::build(keyframe.edges, keyframe.grad_x, keyframe.grad_y)));
-  }
-  for (const CurveObservation& obs : scene.observations) {
-    input.observations.push_back({obs.curve_index, obs.segment_index, obs.keyframe_index});
-  }
-  return input;
-}
 
 struct Solved {
   CurveSceneErrors before;
@@ -37,7 +22,7 @@ struct Solved {
 
 Solved solve(const CurveScene& scene, Strategy strategy,
              const CurveBundleAdjustmentOptions& ba = {}) {
-  const CurveBundleAdjustmentInput input = startingGuess(scene);
+  const CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
   CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
   SchedulerOptions scheduler;
   scheduler.strategy = strategy;
@@ -88,13 +73,13 @@ TEST(CurveBundleAdjustment, AlternatingReachesTheCostOfJointAndImprovesAsMuch) {
   }
 }
 
-TEST(CurveBundleAdjustment, PartlyHiddenCurvesStayNearTheTruth) {
+TEST(CurveBundleAdjustment, PartlyHiddenCurvesAreNotBiasedWithTheOrientationCheck) {
   // Start at the truth with a contiguous 30-50% of a curve hidden in half of the (curve,
-  // keyframe) pairs: hidden samples may slide or be capped, but must not drag the curves far.
-  // Measured: aligned curve error 6.9 mm, ATE 4.7 mm, against 1.4 mm / 1.1 mm with nothing
-  // hidden. So a bias remains; its cause is not traced yet (a candidate: on curved edges, hidden
-  // samples within the reach of the visible end measure along a gradient that is not normal to
-  // them). Issue 3's note tracks it.
+  // keyframe) pairs. Hidden samples within the reach of the visible end match that end, where
+  // the gradient runs along the curve and pulls them towards the visible part. Measured
+  // (seed 42): aligned curve error 7.5 mm, ATE 4.9 mm with every match accepted; 0.8 mm /
+  // 1.6 mm with matches limited to edges within 20 deg of the curve normal; 1.4 mm / 1.1 mm
+  // with nothing hidden.
   CurveSceneOptions options;
   options.pose_noise_translation = 0.0;
   options.pose_noise_rotation_deg = 0.0;
@@ -106,9 +91,15 @@ TEST(CurveBundleAdjustment, PartlyHiddenCurvesStayNearTheTruth) {
   int partly_hidden = 0;
   for (const CurveObservation& obs : scene.observations) partly_hidden += obs.partlyHidden();
   ASSERT_GT(partly_hidden, static_cast<int>(scene.observations.size()) / 8);
-  const Solved solved = solve(scene, Strategy::kJoint);
-  EXPECT_LT(solved.after.position_ate_sim3, 0.007);
-  EXPECT_LT(solved.after.curve_mean_error_aligned, 0.01);
+
+  const Solved unchecked = solve(scene, Strategy::kJoint);
+  CurveBundleAdjustmentOptions ba;
+  ba.max_normal_angle_deg = 20.0;
+  const Solved checked = solve(scene, Strategy::kJoint, ba);
+  EXPECT_LT(checked.after.curve_mean_error_aligned, 0.002);
+  EXPECT_LT(checked.after.position_ate_sim3, 0.003);
+  EXPECT_LT(checked.after.curve_mean_error_aligned,
+            0.3 * unchecked.after.curve_mean_error_aligned);
 }
 
 TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
@@ -131,6 +122,11 @@ TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
   options.lambda1 = -1.0;
   expectRejected(options, "lambda1");
   options = {};
+  options.max_normal_angle_deg = 0.0;
+  expectRejected(options, "max_normal_angle_deg");
+  options.max_normal_angle_deg = 120.0;
+  expectRejected(options, "max_normal_angle_deg");
+  options = {};
   options.lambda2 = std::nan("");
   expectRejected(options, "lambda2");
   options = {};
@@ -146,7 +142,7 @@ TEST(CurveBundleAdjustment, RejectsMismatchedFieldsAndObservationsOutOfRange) {
   options.num_keyframes = 3;
   options.num_curves = 2;
   const CurveScene scene = makeCurveScene(options);
-  CurveBundleAdjustmentInput input = startingGuess(scene);
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
   CurveBundleAdjustmentInput missing_field = input;
   missing_field.fields.pop_back();
   EXPECT_THROW(buildCurveBundleAdjustment(missing_field, {}), CheckError);

@@ -7,12 +7,13 @@
 
 namespace curvesfm {
 
-/// PNG charts for the benchmark harnesses, drawn with OpenCV alone (the machines that run the
-/// experiments have no Python). Two chart kinds share one look: white background, light grey
-/// grid, "nice" 1-2-5 ticks (decades on log axes), a title, axis labels (the y label rotated),
-/// a legend with colour swatches and markers, and a small grey note under the x axis that counts
-/// the values that could not be shown. Colours come from the Okabe-Ito colour-blind-friendly
-/// palette and markers from a list of distinct shapes, both by series index.
+/// PNG charts for the benchmark harnesses and `curvesfm eval --plot`, drawn with OpenCV alone
+/// (the machines that run the experiments have no Python). Two chart kinds share one look:
+/// white background, light grey grid, "nice" 1-2-5 ticks (decades on log axes), a title, axis
+/// labels (the y label rotated), a legend with colour swatches and markers, and a small grey
+/// note under the x axis that counts the values that could not be shown. Colours come from the
+/// Okabe-Ito colour-blind-friendly palette and markers from a list of distinct shapes, both by
+/// series index.
 ///
 /// Rendering is deterministic, single-threaded and takes about 1 ms at 900 x 600; nothing is
 /// cached, so a chart may be changed (add()) and rendered again.
@@ -186,6 +187,10 @@ class BarChart {
   BarChartOptions options_;
   std::vector<BarSeries> series_;
 };
+
+/// Writes `image` (8-bit, 1 or 3 channels) as a PNG file at `png_path` (any extension). Throws
+/// IoError naming the path when it cannot be encoded or written.
+void savePng(const cv::Mat& image, const std::string& png_path);
 
 /// Tick and label helpers, exposed for tests.
 namespace plot_detail {

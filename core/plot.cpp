@@ -1,4 +1,4 @@
-#include "benchmarks/support/plot.h"
+#include "core/plot.h"
 
 #include <algorithm>
 #include <array>
@@ -922,7 +922,9 @@ void validateRange(const char* struct_name, const std::string& field,
           "must be > 0 on a log axis");
 }
 
-void writePng(const cv::Mat& image, const std::string& path) {
+}  // namespace
+
+void savePng(const cv::Mat& image, const std::string& path) {
   std::vector<unsigned char> bytes;
   if (!cv::imencode(".png", image, bytes)) throw IoError(path, "cannot encode the image as PNG");
   std::ofstream file(path, std::ios::binary);
@@ -932,8 +934,6 @@ void writePng(const cv::Mat& image, const std::string& path) {
   file.close();
   if (!file) throw IoError(path, "write failed");
 }
-
-}  // namespace
 
 cv::Scalar paletteColor(int index) {
   // Okabe & Ito (2008), "Color Universal Design", as BGR: blue, vermillion, bluish green,
@@ -1122,7 +1122,7 @@ cv::Rect Plot::plotArea() const {
   return area;
 }
 
-void Plot::save(const std::string& png_path) const { writePng(render(), png_path); }
+void Plot::save(const std::string& png_path) const { savePng(render(), png_path); }
 
 // ---------------------------------------------------------------------------------------------
 // BarChart
@@ -1298,6 +1298,6 @@ cv::Rect BarChart::plotArea() const {
   return area;
 }
 
-void BarChart::save(const std::string& png_path) const { writePng(render(), png_path); }
+void BarChart::save(const std::string& png_path) const { savePng(render(), png_path); }
 
 }  // namespace curvesfm

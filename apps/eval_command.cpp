@@ -1,0 +1,164 @@
+#include "apps/eval_command.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "apps/cli_options.h"
+#include "core/dataset_io.h"
+#include "core/errors.h"
+#include "core/trajectory_plot.h"
+
+namespace curvesfm {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+double rotationAngleDeg(const Eigen::Matrix3d& rotation) {
+  return Eigen::AngleAxisd(rotation).angle() * kRadToDeg;
+}
+
+void printSummary(const TrajectoryEvaluation& e) {
+  std::printf("matched %zu of %d estimated poses (%d ground-truth) within %g s\n", e.matches.size(),
+              e.estimate_poses, e.ground_truth_poses, e.options.max_dt);
+  const Sim3& a = e.ground_truth_from_estimate;
+  std::printf(
+      "alignment %s (ground truth from estimate): scale %.6f, rotation %.4f deg, "
+      "translation [%.6f, %.6f, %.6f] m\n",
+      toString(e.options.alignment).c_str(), a.scale, rotationAngleDeg(a.rotation),
+      a.translation.x(), a.translation.y(), a.translation.z());
+}
+
+void printStatistics(const TrajectoryEvaluation& e) {
+  const ErrorStatistics* columns[] = {&e.ate, &e.rpe_translation_stats, &e.rpe_rotation_stats};
+  std::printf("ATE over %d matched poses; RPE over motions from matched pose k to k+%d",
+              e.ate.count, e.options.rpe_delta);
+  if (e.rpe_translation_stats.count == 0) std::printf(" (none: too few matched poses)");
+  std::printf("\n");
+  std::printf("%-8s %14s %14s %14s\n", "", "ATE (m)", "RPE trans (m)", "RPE rot (deg)");
+  const auto row = [&](const char* name, double ErrorStatistics::*field) {
+    std::printf("%-8s", name);
+    for (const ErrorStatistics* s : columns) std::printf(" %14.6f", s->*field);
+    std::printf("\n");
+  };
+  row("rmse", &ErrorStatistics::rmse);
+  row("mean", &ErrorStatistics::mean);
+  row("median", &ErrorStatistics::median);
+  row("std", &ErrorStatistics::std);
+  row("min", &ErrorStatistics::min);
+  row("max", &ErrorStatistics::max);
+  std::printf("%-8s %14d %14d %14d\n", "count", e.ate.count, e.rpe_translation_stats.count,
+              e.rpe_rotation_stats.count);
+}
+
+nlohmann::json statisticsToJson(const ErrorStatistics& s) {
+  return {{"count", s.count}, {"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median},
+          {"std", s.std},     {"min", s.min},   {"max", s.max}};
+}
+
+nlohmann::json alignmentToJson(const TrajectoryEvaluation& e) {
+  const Sim3& a = e.ground_truth_from_estimate;
+  nlohmann::json rotation = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r)
+    rotation.push_back({a.rotation(r, 0), a.rotation(r, 1), a.rotation(r, 2)});
+  return {{"kind", toString(e.options.alignment)},
+          {"maps", "ground_truth_from_estimate: x_gt = scale * rotation * x_est + translation"},
+          {"scale", a.scale},
+          {"rotation", rotation},
+          {"rotation_angle_deg", rotationAngleDeg(a.rotation)},
+          {"translation_m", {a.translation.x(), a.translation.y(), a.translation.z()}}};
+}
+
+nlohmann::json perPoseToJson(const TrajectoryEvaluation& e) {
+  nlohmann::json poses = {{"estimate_timestamp", nlohmann::json::array()},
+                          {"ground_truth_timestamp", nlohmann::json::array()},
+                          {"ate_m", nlohmann::json::array()}};
+  for (const MatchedPose& m : e.matches) {
+    poses["estimate_timestamp"].push_back(m.estimate_timestamp);
+    poses["ground_truth_timestamp"].push_back(m.ground_truth_timestamp);
+    poses["ate_m"].push_back(m.position_error);
+  }
+  return poses;
+}
+
+void writeJson(const std::string& path, const nlohmann::json& report) {
+  std::ofstream out(path);
+  if (!(out << report.dump(2) << "\n")) throw IoError(path, "cannot write the report");
+}
+
+}  // namespace
+
+EvalCommand::EvalCommand(CLI::App* app) {
+  command_ = app->add_subcommand(
+      "eval",
+      "Trajectory evaluation: ATE (rmse, mean, median, std, min, max) and RPE of an estimated TUM "
+      "trajectory against the ground truth, after timestamp association and alignment.");
+  addConfigFlag(command_);
+  CLI::App* c = command_;
+  c->add_option(
+       "--est", estimate_path_,
+       "Estimated trajectory, TUM lines 'timestamp tx ty tz qx qy qz qw' (camera-to-world)")
+      ->required();
+  c->add_option("--gt", ground_truth_path_, "Ground-truth trajectory, same format")->required();
+  c->add_option_function<std::string>(
+       "--align",
+       [this](const std::string& name) {
+         options_.alignment = parseAlignmentKind(name, "TrajectoryEvaluationOptions", "alignment");
+       },
+       "Alignment of the estimate onto the ground truth: sim3 (monocular), se3 (metric), none")
+      ->default_str(toString(options_.alignment));
+  c->add_option("--max-dt", options_.max_dt,
+                "Largest timestamp difference of a matched pose pair (s)")
+      ->capture_default_str();
+  c->add_option("--rpe-delta", options_.rpe_delta,
+                "RPE frame distance between the poses of a relative motion (matched poses)")
+      ->capture_default_str();
+  c->add_option("--json", json_path_,
+                "Write all figures, the alignment, per-pose errors and the options as JSON");
+  c->add_option("--plot", plot_path_,
+                "Write a PNG: top view of both trajectories (left) and the ATE over time (right)");
+}
+
+int EvalCommand::run() const {
+  const std::vector<StampedPose> estimate = readTrajectory(estimate_path_);
+  const std::vector<StampedPose> ground_truth = readTrajectory(ground_truth_path_);
+  const TrajectoryEvaluation evaluation =
+      compareTrajectories(estimate, ground_truth, options_, estimate_path_, ground_truth_path_);
+
+  printSummary(evaluation);
+  printStatistics(evaluation);
+
+  if (!json_path_.empty()) {
+    writeJson(
+        json_path_,
+        {{"command", "eval"},
+         {"config", optionsToJson(*command_)},
+         {"estimate", {{"path", estimate_path_}, {"poses", evaluation.estimate_poses}}},
+         {"ground_truth", {{"path", ground_truth_path_}, {"poses", evaluation.ground_truth_poses}}},
+         {"matched", evaluation.matches.size()},
+         {"options",
+          {{"alignment", toString(options_.alignment)},
+           {"max_dt_s", options_.max_dt},
+           {"rpe_delta_frames", options_.rpe_delta}}},
+         {"alignment", alignmentToJson(evaluation)},
+         {"ate_m", statisticsToJson(evaluation.ate)},
+         {"rpe_translation_m", statisticsToJson(evaluation.rpe_translation_stats)},
+         {"rpe_rotation_deg", statisticsToJson(evaluation.rpe_rotation_stats)},
+         {"per_pose", perPoseToJson(evaluation)},
+         {"per_rpe_pair",
+          {{"translation_m", evaluation.rpe_translation},
+           {"rotation_deg", evaluation.rpe_rotation_deg}}}});
+    std::printf("json: %s\n", json_path_.c_str());
+  }
+  if (!plot_path_.empty()) {
+    saveTrajectoryEvaluationPlot(plot_path_, evaluation);
+    std::printf("plot: %s\n", plot_path_.c_str());
+  }
+  return 0;
+}
+
+}  // namespace curvesfm

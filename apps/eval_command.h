@@ -1,0 +1,32 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "core/trajectory_evaluation.h"
+
+namespace curvesfm {
+
+/// `curvesfm eval`: compares an estimated TUM trajectory with the ground truth: associates the
+/// poses by timestamp, aligns the estimate (sim3, se3 or none) and prints the ATE and RPE
+/// statistics; optionally writes them as JSON and draws the trajectories and the error as a PNG.
+class EvalCommand {
+ public:
+  explicit EvalCommand(CLI::App* app);
+  bool selected() const { return command_->parsed(); }
+  /// Throws InvalidOptions for flag values out of range (a usage error, before any file is read).
+  void validate() const { options_.validate(); }
+  /// Runs the command; returns the process exit code. Bad files and options throw curvesfm
+  /// errors (IoError, ParseError, InvalidOptions, TrajectoryEvaluationError).
+  int run() const;
+
+ private:
+  CLI::App* command_;
+  std::string estimate_path_;
+  std::string ground_truth_path_;
+  TrajectoryEvaluationOptions options_;
+  std::string json_path_;
+  std::string plot_path_;
+};
+
+}  // namespace curvesfm

@@ -1,0 +1,110 @@
+#include "apps/synth_command.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "apps/cli_options.h"
+#include "core/dataset_io.h"
+#include "core/errors.h"
+
+namespace curvesfm {
+namespace {
+
+// An empty path would only fail later, with a message that names nothing.
+const CLI::Validator kNotEmpty(
+    [](std::string& value) { return value.empty() ? std::string("must not be empty") : ""; }, "");
+
+void printSummary(const std::string& image_path, const std::string& out_dir,
+                  const PlanarSceneOptions& options, const PlanarScene& scene) {
+  const double distance = std::hypot(options.orbit_radius, options.camera_height);
+  std::printf("synth planar: %zu frames of %dx%d px (fx %g, fy %g, cx %g, cy %g), 1/30 s apart\n",
+              scene.images.size(), options.width, options.height, options.fx, options.fy,
+              options.cx, options.cy);
+  std::printf("photo: %s, %dx%d px, laid as a %.3f x %.3f m plane at z = 0\n", image_path.c_str(),
+              scene.texture.image.cols, scene.texture.image.rows, scene.texture.width_m,
+              scene.texture.height_m);
+  std::printf("orbit: radius %.3f m at height %.3f m over %g deg, %.3f m from the plane centre\n",
+              options.orbit_radius, options.camera_height, options.arc_degrees, distance);
+  std::printf("baseline: %.1f mm between frames (%.2f%% of the distance), %.1f mm first to last\n",
+              1e3 * scene.meanFrameBaseline(), 100.0 * scene.meanFrameBaseline() / distance,
+              1e3 * scene.firstToLastBaseline());
+  std::printf("noise: intensity std dev %.2f levels (%g x 255) per pixel and channel, seed %u\n",
+              options.intensity_noise * 255.0, options.intensity_noise, options.seed);
+  std::printf("initial poses: every frame perturbed, std dev %g m and %g deg per axis\n",
+              options.init_noise_translation, options.init_noise_rotation_deg);
+  std::printf(
+      "written: %s (rgb.txt, rgb/ with %zu PNG, camera.yaml, groundtruth.txt, "
+      "init_poses.txt)\n",
+      out_dir.c_str(), scene.images.size());
+}
+
+}  // namespace
+
+SynthCommand::SynthCommand(CLI::App* app) {
+  CLI::App* synth =
+      app->add_subcommand("synth",
+                          "Write a synthetic dataset (TUM RGB-D layout with groundtruth.txt and "
+                          "init_poses.txt); `curvesfm synth <kind> --help` for a kind's flags.");
+  synth->require_subcommand(1);
+  planar_ = synth->add_subcommand(
+      "planar",
+      "The paper's planar protocol (4.1): a photograph laid on a plane, a camera orbiting above "
+      "it looking at its centre, views rendered by homography with Gaussian intensity noise, "
+      "the true trajectory and a perturbed one as starting guess.");
+  addConfigFlag(planar_);
+  CLI::App* c = planar_;
+  c->add_option("--image", image_path_, "The photograph (any format OpenCV reads)")
+      ->required()
+      ->check(kNotEmpty);
+  c->add_option("--out", out_dir_, "Dataset folder to write (created if needed)")
+      ->required()
+      ->check(kNotEmpty);
+  c->add_option("--frames", options_.num_frames, "Views along the orbit arc")
+      ->capture_default_str();
+  c->add_option("--noise", options_.intensity_noise,
+                "P: std dev of the per-pixel, per-channel intensity noise as a fraction of 255 "
+                "(0.05 = 5%)")
+      ->capture_default_str();
+  c->add_option("--seed", options_.seed, "Random seed of the noise and the initial poses")
+      ->capture_default_str();
+  c->add_option("--init-noise-trans", options_.init_noise_translation,
+                "Initial poses: std dev per axis of the camera-centre error (m)")
+      ->capture_default_str();
+  c->add_option("--init-noise-rot", options_.init_noise_rotation_deg,
+                "Initial poses: std dev per axis of the rotation error (deg)")
+      ->capture_default_str();
+  c->add_option("--width", options_.width, "Image width (px); the principal point is centred")
+      ->capture_default_str();
+  c->add_option("--height", options_.height, "Image height (px)")->capture_default_str();
+  c->add_option("--plane-width", options_.plane_width,
+                "Extent of the photo's longer side on the plane (m)")
+      ->capture_default_str();
+  c->add_option("--orbit-radius", options_.orbit_radius,
+                "Horizontal distance of the cameras from the plane centre (m)")
+      ->capture_default_str();
+  c->add_option("--camera-height", options_.camera_height, "Height of the orbit (m)")
+      ->capture_default_str();
+  c->add_option("--arc", options_.arc_degrees, "Orbit arc spanned by the views (deg)")
+      ->capture_default_str();
+}
+
+PlanarSceneOptions SynthCommand::planarOptions() const {
+  PlanarSceneOptions options = options_;
+  options.cx = 0.5 * (options.width - 1);
+  options.cy = 0.5 * (options.height - 1);
+  return options;
+}
+
+void SynthCommand::validate() const { planarOptions().validate(); }
+
+int SynthCommand::run() const {
+  const PlanarSceneOptions options = planarOptions();
+  options.validate();
+  const cv::Mat photo = readColorImage(image_path_);
+  const PlanarScene scene = makePlanarScene(photo, options);
+  writePlanarDataset(out_dir_, scene);
+  printSummary(image_path_, out_dir_, options, scene);
+  return 0;
+}
+
+}  // namespace curvesfm

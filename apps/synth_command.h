@@ -1,0 +1,35 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "sim/planar_scene.h"
+
+namespace curvesfm {
+
+/// `curvesfm synth <kind>`: writes synthetic datasets in the TUM RGB-D layout of DESIGN.md.
+/// `synth planar` is the paper's planar protocol (§4.1): a photograph laid on a plane, a camera
+/// orbiting above it, views rendered by homography with Gaussian intensity noise, the true
+/// trajectory (groundtruth.txt) and a perturbed one (init_poses.txt).
+class SynthCommand {
+ public:
+  explicit SynthCommand(CLI::App* app);
+  bool selected() const { return planar_->parsed(); }
+  /// Throws InvalidOptions for an option out of range (main reports it as a usage error).
+  void validate() const;
+  /// Loads the photo, renders and writes the dataset, prints a summary; returns the exit code.
+  /// Throws what validate() throws, IoError for a photo that does not load or a dataset that
+  /// cannot be written.
+  int run() const;
+
+ private:
+  /// The scene options as run: the principal point is the centre of the chosen image size.
+  PlanarSceneOptions planarOptions() const;
+
+  CLI::App* planar_;
+  PlanarSceneOptions options_;
+  std::string image_path_;
+  std::string out_dir_;
+};
+
+}  // namespace curvesfm

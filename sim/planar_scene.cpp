@@ -1,0 +1,263 @@
+#include "sim/planar_scene.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <sstream>
+#include <system_error>
+
+#include "core/check.h"
+#include "core/dataset_io.h"
+#include "core/errors.h"
+
+namespace curvesfm {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+// Far beyond any real camera; it keeps a mistyped size from allocating gigabytes per frame.
+constexpr int kMaxImageSide = 16384;
+
+void require(bool ok, const char* field, double value, const char* constraint) {
+  if (ok) return;
+  std::ostringstream text;
+  text << value;
+  throw InvalidOptions("PlanarSceneOptions", field, text.str(), constraint);
+}
+
+void checkTexture(const cv::Mat& texture) {
+  CURVESFM_CHECK(!texture.empty() && texture.depth() == CV_8U &&
+                 (texture.channels() == 1 || texture.channels() == 3))
+      << "the planar texture must be a non-empty 8-bit grey or BGR image, got " << texture.cols
+      << "x" << texture.rows << " of OpenCV type " << texture.type();
+}
+
+// Camera at `centre` looking at the origin, its image x axis horizontal and its image y axis
+// pointing down the slope of the view, as a person looking down at a table.
+Pose3 lookAtPlaneCentre(const Eigen::Vector3d& centre) {
+  const Eigen::Vector3d z = -centre.normalized();
+  const Eigen::Vector3d down = -Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d y = (down - down.dot(z) * z).normalized();
+  Eigen::Matrix3d world_from_cam_rotation;
+  world_from_cam_rotation << y.cross(z), y, z;
+  return Pose3(world_from_cam_rotation, centre).inverse();
+}
+
+Pose3 orbitPose(const PlanarSceneOptions& options, int frame) {
+  const double arc = options.arc_degrees * kDegToRad;
+  const double azimuth = -0.5 * M_PI + arc * (double(frame) / (options.num_frames - 1) - 0.5);
+  return lookAtPlaneCentre(Eigen::Vector3d(options.orbit_radius * std::cos(azimuth),
+                                           options.orbit_radius * std::sin(azimuth),
+                                           options.camera_height));
+}
+
+// An isotropic rotation error (so applying it in the world frame is the same as in the camera
+// frame) and a shift of the camera centre in the world.
+Pose3 perturb(const Pose3& cam_from_world, const PlanarSceneOptions& options, std::mt19937& rng) {
+  std::normal_distribution<double> rotation(0.0, options.init_noise_rotation_deg * kDegToRad);
+  std::normal_distribution<double> translation(0.0, options.init_noise_translation);
+  Vector6d delta;
+  for (int k = 0; k < 3; ++k) delta(k) = rotation(rng);
+  for (int k = 3; k < 6; ++k) delta(k) = translation(rng);
+  return cam_from_world.inverse().retract(delta).inverse();
+}
+
+void addIntensityNoise(double sigma, cv::RNG& rng, cv::Mat* image) {
+  if (sigma <= 0.0) return;
+  cv::Mat noisy;
+  image->convertTo(noisy, CV_32F);
+  cv::Mat noise(noisy.size(), noisy.type());
+  rng.fill(noise, cv::RNG::NORMAL, cv::Scalar::all(0.0), cv::Scalar::all(sigma));
+  noisy += noise;
+  noisy.convertTo(*image, CV_8U);  // rounds and clips to [0, 255]
+}
+
+// A homography cannot tell the two sides of the camera apart: warpPerspective also paints the
+// pixels whose ray meets the plane behind the camera. `inverse_depth` is the row of
+// texture_from_image that gives 1 / depth of a pixel's plane point.
+void fillBehindCamera(const Eigen::RowVector3d& inverse_depth, const cv::Scalar& fill,
+                      cv::Mat* view) {
+  cv::Mat behind(view->size(), CV_8U);
+  for (int y = 0; y < view->rows; ++y) {
+    auto* row = behind.ptr<unsigned char>(y);
+    for (int x = 0; x < view->cols; ++x) {
+      row[x] = inverse_depth.dot(Eigen::Vector3d(x, y, 1.0)) > 0.0 ? 0 : 255;
+    }
+  }
+  view->setTo(fill, behind);
+}
+
+void createFolder(const std::filesystem::path& folder) {
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) throw IoError(folder.string(), "cannot create the folder: " + error.message());
+  if (!std::filesystem::is_directory(folder, error)) {
+    throw IoError(folder.string(), "cannot create the folder: a file of that name exists");
+  }
+}
+
+std::string imageName(std::size_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "rgb/%06zu.png", frame);
+  return name;
+}
+
+std::vector<StampedPose> stamped(const std::vector<double>& timestamps,
+                                 const std::vector<Pose3>& cam_from_world) {
+  std::vector<StampedPose> poses;
+  for (std::size_t i = 0; i < timestamps.size(); ++i) {
+    poses.push_back({timestamps[i], cam_from_world[i].inverse()});
+  }
+  return poses;
+}
+
+}  // namespace
+
+CameraIntrinsics PlanarSceneOptions::intrinsics() const {
+  CameraIntrinsics intrinsics;
+  intrinsics.fx = fx;
+  intrinsics.fy = fy;
+  intrinsics.cx = cx;
+  intrinsics.cy = cy;
+  intrinsics.width = width;
+  intrinsics.height = height;
+  return intrinsics;
+}
+
+void PlanarSceneOptions::validate() const {
+  require(num_frames >= 2, "num_frames", num_frames, "must be >= 2");
+  require(intensity_noise >= 0.0 && intensity_noise <= 1.0, "intensity_noise", intensity_noise,
+          "must be in [0, 1] (a fraction of 255)");
+  require(std::isfinite(init_noise_translation) && init_noise_translation >= 0.0,
+          "init_noise_translation", init_noise_translation, "must be finite and >= 0");
+  require(std::isfinite(init_noise_rotation_deg) && init_noise_rotation_deg >= 0.0,
+          "init_noise_rotation_deg", init_noise_rotation_deg, "must be finite and >= 0");
+  require(width >= 1 && width <= kMaxImageSide, "width", width, "must be in [1, 16384]");
+  require(height >= 1 && height <= kMaxImageSide, "height", height, "must be in [1, 16384]");
+  require(std::isfinite(fx) && fx > 0.0, "fx", fx, "must be finite and > 0");
+  require(std::isfinite(fy) && fy > 0.0, "fy", fy, "must be finite and > 0");
+  require(std::isfinite(cx), "cx", cx, "must be finite");
+  require(std::isfinite(cy), "cy", cy, "must be finite");
+  require(std::isfinite(plane_width) && plane_width > 0.0, "plane_width", plane_width,
+          "must be finite and > 0");
+  require(std::isfinite(orbit_radius) && orbit_radius > 0.0, "orbit_radius", orbit_radius,
+          "must be finite and > 0");
+  require(std::isfinite(camera_height) && camera_height > 0.0, "camera_height", camera_height,
+          "must be finite and > 0");
+  require(arc_degrees > 0.0 && arc_degrees < 360.0, "arc_degrees", arc_degrees,
+          "must be in (0, 360)");
+}
+
+Eigen::Matrix3d PlanarTexture::planeFromTexture() const {
+  const double sx = width_m / image.cols;
+  const double sy = height_m / image.rows;
+  Eigen::Matrix3d plane_from_texture;
+  plane_from_texture << sx, 0.0, 0.5 * (sx - width_m),  //
+      0.0, -sy, 0.5 * (height_m - sy),                  //
+      0.0, 0.0, 1.0;
+  return plane_from_texture;
+}
+
+PlanarTexture makePlanarTexture(const cv::Mat& image, double plane_width_m) {
+  checkTexture(image);
+  CURVESFM_CHECK(std::isfinite(plane_width_m) && plane_width_m > 0.0)
+      << "plane width " << plane_width_m << " m";
+  const double metres_per_pixel = plane_width_m / std::max(image.cols, image.rows);
+  return {image, image.cols * metres_per_pixel, image.rows * metres_per_pixel};
+}
+
+cv::Mat renderPlanarView(const cv::Mat& texture_bgr, double plane_width_m, const Camera& camera,
+                         const Pose3& cam_from_world, int background) {
+  CURVESFM_CHECK(!camera.hasDistortion()) << "a homography cannot render lens distortion";
+  CURVESFM_CHECK(background >= 0 && background <= 255) << "background " << background;
+  const PlanarTexture texture = makePlanarTexture(texture_bgr, plane_width_m);
+  const cv::Size size(camera.width(), camera.height());
+  const cv::Scalar fill = cv::Scalar::all(background);
+
+  const Eigen::Matrix3d rotation = cam_from_world.rotationMatrix();
+  Eigen::Matrix3d cam_from_plane;
+  cam_from_plane << rotation.col(0), rotation.col(1), cam_from_world.translation();
+  // The determinant is minus the camera's height: a camera in the plane sees it edge-on.
+  if (!(std::abs(cam_from_plane.determinant()) > 1e-12)) {
+    return cv::Mat(size, texture_bgr.type(), fill);
+  }
+  // Inverted here, unscaled, so that its last row stays the pixel's inverse depth.
+  const Eigen::Matrix3d texture_from_image =
+      (camera.K() * cam_from_plane * texture.planeFromTexture()).inverse();
+  cv::Matx33d map;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) map(r, c) = texture_from_image(r, c);
+  }
+  cv::Mat view;
+  cv::warpPerspective(texture_bgr, view, map, size, cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
+                      cv::BORDER_CONSTANT, fill);
+  fillBehindCamera(texture_from_image.row(2), fill, &view);
+  return view;
+}
+
+double PlanarScene::meanFrameBaseline() const {
+  if (true_cam_from_world.size() < 2) return 0.0;
+  double sum = 0.0;
+  for (std::size_t i = 1; i < true_cam_from_world.size(); ++i) {
+    sum += (true_cam_from_world[i].inverseTranslation() -
+            true_cam_from_world[i - 1].inverseTranslation())
+               .norm();
+  }
+  return sum / (true_cam_from_world.size() - 1);
+}
+
+double PlanarScene::firstToLastBaseline() const {
+  if (true_cam_from_world.empty()) return 0.0;
+  return (true_cam_from_world.back().inverseTranslation() -
+          true_cam_from_world.front().inverseTranslation())
+      .norm();
+}
+
+PlanarScene makePlanarScene(const cv::Mat& texture_bgr, const PlanarSceneOptions& options) {
+  options.validate();
+  PlanarScene scene;
+  scene.camera = std::make_shared<const Camera>(options.intrinsics());
+  scene.texture = makePlanarTexture(texture_bgr, options.plane_width);
+  // Separate streams: the noise level does not change the initial poses, nor the reverse.
+  std::mt19937 pose_rng(options.seed);
+  cv::RNG noise_rng(options.seed);
+  for (int i = 0; i < options.num_frames; ++i) {
+    const Pose3 truth = orbitPose(options, i);
+    scene.timestamps.push_back(i * kPlanarFramePeriod);
+    scene.true_cam_from_world.push_back(truth);
+    scene.initial_cam_from_world.push_back(perturb(truth, options, pose_rng));
+    cv::Mat image = renderPlanarView(texture_bgr, options.plane_width, *scene.camera, truth);
+    addIntensityNoise(options.intensity_noise * 255.0, noise_rng, &image);
+    scene.images.push_back(image);
+  }
+  return scene;
+}
+
+void writePlanarDataset(const std::string& dir, const PlanarScene& scene) {
+  const std::size_t frames = scene.timestamps.size();
+  CURVESFM_CHECK(scene.camera && scene.images.size() == frames &&
+                 scene.true_cam_from_world.size() == frames &&
+                 scene.initial_cam_from_world.size() == frames)
+      << "a planar scene needs a camera and one image and two poses per timestamp";
+  CURVESFM_CHECK(!dir.empty()) << "the dataset folder must be named";
+  const std::filesystem::path root(dir);
+  createFolder(root);
+  createFolder(root / "rgb");
+  std::vector<ImageEntry> entries;
+  for (std::size_t i = 0; i < frames; ++i) {
+    entries.push_back({scene.timestamps[i], imageName(i)});
+    writeImage((root / entries.back().path).string(), scene.images[i]);
+  }
+  writeImageList((root / "rgb.txt").string(), entries);
+  writeCameraYaml((root / "camera.yaml").string(), *scene.camera);
+  writeTrajectory((root / "groundtruth.txt").string(),
+                  stamped(scene.timestamps, scene.true_cam_from_world));
+  writeTrajectory((root / "init_poses.txt").string(),
+                  stamped(scene.timestamps, scene.initial_cam_from_world));
+}
+
+}  // namespace curvesfm

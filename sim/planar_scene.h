@@ -1,0 +1,136 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/pose3.h"
+
+namespace curvesfm {
+
+// The paper's planar protocol (§4.1): a real photograph laid on a plane, a camera orbiting above
+// it, every view rendered exactly by the plane's homography, per-pixel Gaussian intensity noise,
+// and the true trajectory perturbed as a starting guess. Real image content, exact ground truth,
+// no correspondence problem.
+//
+// World frame: the photo lies on the plane z = 0, centred at the origin, its columns along +x
+// and its rows along -y (the photo's top edge is at +y), so z points up out of the photo's face
+// and a camera above the plane (z > 0) sees it unmirrored. Units: metres, pixels (centres at
+// integers, as Camera::project), 8-bit intensities.
+
+/// Colour of the image pixels that do not see the photo (outside it or above the horizon).
+inline constexpr int kPlanarBackground = 0;
+
+/// Frame period of the rendered sequence: timestamps are i / 30 s, a TUM RGB-D camera's rate.
+inline constexpr double kPlanarFramePeriod = 1.0 / 30.0;
+
+/// Options of makePlanarScene(). The default orbit (height 0.6 m, radius 0.25 m, 90 deg arc)
+/// keeps the camera 0.65 m from the photo's centre, 23 deg off the vertical: a default 4:3 photo
+/// (1.0 x 0.75 m) then fills at least 90% of every 640x480 view, the views are 13.5 mm apart
+/// (2% of the viewing distance, 11 px of parallax at the plane) and the first and last are 0.35 m
+/// apart and see the plane's centre from directions 32 deg apart, enough to triangulate well
+/// without a strong perspective change between neighbours.
+struct PlanarSceneOptions {
+  int num_frames = 30;  ///< Views along the orbit; >= 2.
+  /// P: std dev of the Gaussian noise added to every pixel and channel, as a fraction of 255
+  /// (0.05 gives a std dev of 12.75 levels), before rounding and clipping to [0, 255]; [0, 1].
+  double intensity_noise = 0.0;
+  /// Seed of the image noise and of the pose perturbation (independent streams); the same
+  /// options and photo give bit-identical scenes.
+  unsigned seed = 1;
+  /// Std dev per world axis of the error of every initial camera centre (m); finite, >= 0.
+  double init_noise_translation = 0.02;
+  /// Std dev per axis of the rotation-vector error of every initial camera orientation (deg);
+  /// the rms angle is sqrt(3) times this; finite, >= 0.
+  double init_noise_rotation_deg = 1.0;
+  int width = 640;    ///< Image width (px); in [1, 16384].
+  int height = 480;   ///< Image height (px); in [1, 16384].
+  double fx = 525.0;  ///< Focal length along x (px); > 0. No distortion: views are homographies.
+  double fy = 525.0;  ///< Focal length along y (px); > 0.
+  double cx = 319.5;  ///< Principal point x (px, pixel centres at integers); finite.
+  double cy = 239.5;  ///< Principal point y (px); finite.
+  /// Extent of the photo's longer side on the plane (m); > 0. The shorter side follows the
+  /// photo's aspect ratio (square pixels).
+  double plane_width = 1.0;
+  /// Horizontal distance of every camera centre from the photo's centre (m); > 0 (a camera
+  /// straight above the centre has no defined "up" and the orbit no baseline).
+  double orbit_radius = 0.25;
+  double camera_height = 0.6;  ///< Height of the orbit above the plane (m); > 0.
+  /// Angle of the orbit arc that the views span, evenly spaced and centred on the view from the
+  /// side of the photo's bottom edge (-y), which sees the photo upright (deg); in (0, 360): a
+  /// closed circle would repeat the first view.
+  double arc_degrees = 90.0;
+
+  /// The camera these options describe (no distortion).
+  CameraIntrinsics intrinsics() const;
+
+  /// Throws InvalidOptions naming the field, its value and the constraint.
+  void validate() const;
+};
+
+/// A photo on the plane z = 0 (see the frame convention above). Texture pixel (u, v) (centres at
+/// integers) is the rectangle of size width_m / cols x height_m / rows centred at
+///   x = (u + 0.5) width_m / cols - width_m / 2,   y = height_m / 2 - (v + 0.5) height_m / rows.
+struct PlanarTexture {
+  cv::Mat image;          ///< The photo, CV_8UC1 or CV_8UC3 (BGR).
+  double width_m = 0.0;   ///< Extent along world x (m); > 0.
+  double height_m = 0.0;  ///< Extent along world y (m); > 0.
+
+  /// The 3x3 homogeneous map from texture pixel (u, v, 1) to plane point (x, y, 1).
+  Eigen::Matrix3d planeFromTexture() const;
+};
+
+/// `image` laid on the plane with its longer side spanning plane_width_m (> 0), square pixels.
+/// The image is shared, not copied. CheckError for an empty image or a non-positive width.
+PlanarTexture makePlanarTexture(const cv::Mat& image, double plane_width_m);
+
+/// Renders what `camera` at `cam_from_world` sees of the photo `texture_bgr` (CV_8UC1 or
+/// CV_8UC3) laid on the plane with its longer side spanning plane_width_m: the homography
+/// K [r1 r2 t] planeFromTexture() applied by cv::warpPerspective with bilinear interpolation
+/// (OpenCV's 1/32 px sub-pixel grid). Pixels whose ray misses the photo, or meets the plane
+/// behind the camera, are `background` (0..255, every channel); the photo's border pixels blend
+/// with it. Returns an image of the camera's size and the texture's type; an all-background
+/// image if the camera centre lies in the plane. CheckError for a camera with distortion (a
+/// homography cannot render it), an empty or non-8-bit texture, or plane_width_m <= 0.
+cv::Mat renderPlanarView(const cv::Mat& texture_bgr, double plane_width_m, const Camera& camera,
+                         const Pose3& cam_from_world, int background = kPlanarBackground);
+
+/// A rendered planar sequence. All vectors are index-aligned, one entry per frame.
+struct PlanarScene {
+  std::shared_ptr<const Camera> camera;
+  PlanarTexture texture;                   ///< The photo as laid on the plane.
+  std::vector<double> timestamps;          ///< i * kPlanarFramePeriod (s).
+  std::vector<Pose3> true_cam_from_world;  ///< The orbit (see PlanarSceneOptions).
+  /// The starting guess: every pose perturbed, the first one included. A solver that fixes its
+  /// first pose as the gauge then works in a frame slightly off the truth, as with any real
+  /// initialiser (the paper used ORB-SLAM's poses), so evaluate with a Sim(3) (or SE(3))
+  /// alignment to the ground truth (`curvesfm eval` does by default).
+  std::vector<Pose3> initial_cam_from_world;
+  std::vector<cv::Mat> images;  ///< Rendered views with noise, the texture's type.
+
+  /// Mean distance between consecutive true camera centres (m); 0 for fewer than 2 frames.
+  double meanFrameBaseline() const;
+  /// Distance between the first and the last true camera centres (m).
+  double firstToLastBaseline() const;
+};
+
+/// Builds the scene from the photo `texture_bgr` (CV_8UC1 or CV_8UC3): cameras evenly spaced on
+/// the orbit arc (see PlanarSceneOptions), each looking at the photo's centre with its image x
+/// axis horizontal, renderPlanarView() views with Gaussian noise (cv::RNG, `seed`) added per
+/// pixel and channel, and perturbed initial poses (an isotropic Gaussian rotation-vector error
+/// and a Gaussian shift of the camera centre in the world; std::mt19937, `seed`). All images are
+/// held in memory (width x height x channels bytes each). Throws InvalidOptions for invalid
+/// options, CheckError for an empty or non-8-bit texture.
+PlanarScene makePlanarScene(const cv::Mat& texture_bgr, const PlanarSceneOptions& options);
+
+/// Writes the scene as a dataset in DESIGN.md's TUM RGB-D layout: `dir`/rgb.txt, rgb/NNNNNN.png
+/// (lossless, frame index with 6 digits), camera.yaml, groundtruth.txt (true poses) and
+/// init_poses.txt (initial poses), trajectories camera-to-world. Creates `dir` and rgb/ if
+/// needed; existing files of the same names are overwritten, others left alone. Throws IoError
+/// naming the path that cannot be created or written.
+void writePlanarDataset(const std::string& dir, const PlanarScene& scene);
+
+}  // namespace curvesfm

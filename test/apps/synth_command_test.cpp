@@ -1,0 +1,131 @@
+// `curvesfm synth planar` end to end: the real executable, the dataset it writes read back with
+// the dataset readers, its messages and exit codes.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "core/dataset_io.h"
+#include "test/support/run_curvesfm.h"
+
+namespace curvesfm {
+namespace {
+
+using ::testing::HasSubstr;
+
+using testing::CommandResult;
+using testing::runCurvesfm;
+
+class SynthCommandTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    folder_ = std::filesystem::path(::testing::TempDir()) /
+              ("synth_command_test_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(folder_);
+    std::filesystem::create_directories(folder_);
+    // A small photo with structure: a colour gradient and a dark disc.
+    cv::Mat photo(60, 80, CV_8UC3);
+    for (int r = 0; r < photo.rows; ++r) {
+      for (int c = 0; c < photo.cols; ++c) {
+        const bool disc = (r - 30) * (r - 30) + (c - 40) * (c - 40) < 15 * 15;
+        photo.at<cv::Vec3b>(r, c) = disc ? cv::Vec3b(20, 20, 20) : cv::Vec3b(3 * c, 4 * r, 200);
+      }
+    }
+    writeImage(path("photo.png"), photo);
+  }
+  void TearDown() override { std::filesystem::remove_all(folder_); }
+
+  std::string path(const std::string& name) const { return (folder_ / name).string(); }
+
+  std::filesystem::path folder_;
+};
+
+TEST_F(SynthCommandTest, WritesAThreeFrameDatasetThatTheReadersReadBack) {
+  const std::string out = path("dataset");
+  const CommandResult result =
+      runCurvesfm("synth planar --image " + path("photo.png") + " --out " + out +
+                  " --frames 3 --width 160 --height 120 --noise 0.05 --seed 4");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("synth planar: 3 frames of 160x120 px"));
+  EXPECT_THAT(result.output, HasSubstr("baseline: "));
+  EXPECT_THAT(result.output, HasSubstr("noise: intensity std dev 12.75 levels"));
+  EXPECT_THAT(result.output, HasSubstr("written: " + out));
+
+  const std::vector<ImageEntry> images = readImageList(out + "/rgb.txt");
+  const std::vector<StampedPose> truth = readTrajectory(out + "/groundtruth.txt");
+  const std::vector<StampedPose> initial = readTrajectory(out + "/init_poses.txt");
+  const Camera camera = readCameraYaml(out + "/camera.yaml");
+  ASSERT_EQ(images.size(), 3u);
+  ASSERT_EQ(truth.size(), 3u);
+  ASSERT_EQ(initial.size(), 3u);
+  EXPECT_EQ(camera.width(), 160);
+  EXPECT_EQ(camera.height(), 120);
+  EXPECT_EQ(camera.cx(), 79.5);
+  EXPECT_EQ(camera.fx(), 525.0);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(images[i].timestamp, truth[i].timestamp);
+    EXPECT_EQ(images[i].timestamp, initial[i].timestamp);
+    const cv::Mat image = readColorImage(images[i].path);
+    EXPECT_EQ(image.cols, 160);
+    EXPECT_EQ(image.rows, 120);
+    // Camera-to-world: the translation is the camera centre, 0.6 m above the plane.
+    EXPECT_NEAR(truth[i].world_from_cam.translation().z(), 0.6, 1e-9);
+    EXPECT_GT(
+        (initial[i].world_from_cam.translation() - truth[i].world_from_cam.translation()).norm(),
+        0.0);
+  }
+}
+
+TEST_F(SynthCommandTest, PhotoThatDoesNotLoadIsOneLineNamingTheFileAndExit1) {
+  const std::string missing = path("missing.png");
+  CommandResult result = runCurvesfm("synth planar --image " + missing + " --out " + path("d"));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_EQ(result.output, "IoError: " + missing + ": no such file\n");
+
+  const std::string text = path("text.png");
+  std::ofstream(text) << "not an image";
+  result = runCurvesfm("synth planar --image " + text + " --out " + path("d"));
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.output, HasSubstr("IoError: " + text + ": cannot decode as an image"));
+  EXPECT_FALSE(std::filesystem::exists(path("d")));
+}
+
+TEST_F(SynthCommandTest, BadValuesAreUsageErrorsNamingTheOption) {
+  const std::string flags = "synth planar --image " + path("photo.png") + " --out " + path("d");
+  CommandResult result = runCurvesfm(flags + " --noise 5");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("PlanarSceneOptions.intensity_noise = 5"));
+  result = runCurvesfm(flags + " --frames 1");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("PlanarSceneOptions.num_frames = 1"));
+  result = runCurvesfm(flags + " --frames many");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--frames"));
+  result = runCurvesfm("synth planar --image " + path("photo.png"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--out is required"));
+  EXPECT_EQ(runCurvesfm("synth").exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(path("d")));
+}
+
+TEST_F(SynthCommandTest, ConfigFileSuppliesEveryFlagAndTheCommandLineWins) {
+  const std::string config = path("planar.yaml");
+  std::ofstream(config) << "image: " << path("photo.png") << "\nout: " << path("from_config")
+                        << "\nframes: 2\nwidth: 80\nheight: 60\n";
+  const CommandResult result = runCurvesfm("synth planar --config " + config + " --frames 3");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(readImageList(path("from_config") + "/rgb.txt").size(), 3u);
+  EXPECT_EQ(readCameraYaml(path("from_config") + "/camera.yaml").width(), 80);
+
+  std::ofstream(config) << "frames: 2\nframe: 3\n";
+  const CommandResult bad = runCurvesfm("synth planar --config " + config);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(bad.output, HasSubstr(config + ":2: expected a flag of 'curvesfm synth planar'"));
+}
+
+}  // namespace
+}  // namespace curvesfm

@@ -1,5 +1,8 @@
 #include "core/errors.h"
 
+#include <locale>
+#include <sstream>
+
 namespace curvesfm {
 
 IoError::IoError(const std::string& path, const std::string& problem)
@@ -15,5 +18,17 @@ ParseError::ParseError(const std::string& path, int line, const std::string& exp
 InvalidOptions::InvalidOptions(const std::string& struct_name, const std::string& field,
                                const std::string& value, const std::string& constraint)
     : Error("InvalidOptions: " + struct_name + "." + field + " = " + value + ": " + constraint) {}
+
+std::string formatOptionValue(double value) {
+  std::ostringstream out;
+  out.imbue(std::locale::classic());
+  out << value;
+  return out.str();
+}
+
+void requireOption(bool ok, const std::string& struct_name, const std::string& field, double value,
+                   const std::string& constraint) {
+  if (!ok) throw InvalidOptions(struct_name, field, formatOptionValue(value), constraint);
+}
 
 }  // namespace curvesfm

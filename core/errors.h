@@ -40,6 +40,14 @@ class InvalidOptions : public Error {
                  const std::string& constraint);
 };
 
+/// A number as options messages print it (shortest round-trip-ish form, C locale).
+std::string formatOptionValue(double value);
+
+/// For validate(): throws InvalidOptions(struct_name, field, formatOptionValue(value),
+/// constraint) unless `ok`. Write `ok` as a positive comparison (value >= low) so NaN fails.
+void requireOption(bool ok, const std::string& struct_name, const std::string& field, double value,
+                   const std::string& constraint);
+
 /// A violated internal invariant (a programmer error), thrown by CURVESFM_CHECK.
 class CheckError : public Error {
  public:

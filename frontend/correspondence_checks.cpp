@@ -26,10 +26,7 @@ constexpr double kEdgePieceHalfLength = 0.5 * M_SQRT2;
 // Options.
 
 void require(bool ok, const char* field, double value, const char* constraint) {
-  if (ok) return;
-  std::ostringstream text;
-  text << value;
-  throw InvalidOptions("CorrespondenceOptions", field, text.str(), constraint);
+  requireOption(ok, "CorrespondenceOptions", field, value, constraint);
 }
 
 // ------------------------------------------------------------------------------------------------

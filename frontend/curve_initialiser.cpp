@@ -195,10 +195,7 @@ void CurveInitialiserOptions::validate() const {
        "in (0, 100]"},
   };
   for (const auto& check : checks) {
-    if (check.ok) continue;
-    std::ostringstream value;
-    value << check.value;
-    throw InvalidOptions("CurveInitialiserOptions", check.field, value.str(), check.constraint);
+    requireOption(check.ok, "CurveInitialiserOptions", check.field, check.value, check.constraint);
   }
 }
 

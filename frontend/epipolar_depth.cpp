@@ -39,14 +39,8 @@ constexpr int kRankingSamples = 1024;
 // ------------------------------------------------------------------------------------------------
 // Options.
 
-std::string formatValue(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
 void require(bool ok, const char* field, double value, const char* constraint) {
-  if (!ok) throw InvalidOptions("EpipolarDepthOptions", field, formatValue(value), constraint);
+  requireOption(ok, "EpipolarDepthOptions", field, value, constraint);
 }
 
 // Written as positive comparisons so that NaN fails.

@@ -65,15 +65,8 @@ constexpr unsigned kRenderStream = 3;
 // ------------------------------------------------------------------------------------------
 // Options.
 
-std::string formatValue(double value) {
-  std::ostringstream out;
-  out.imbue(std::locale::classic());
-  out << value;
-  return out.str();
-}
-
 void require(bool ok, const char* field, double value, const char* constraint) {
-  if (!ok) throw InvalidOptions("CurveSceneOptions", field, formatValue(value), constraint);
+  requireOption(ok, "CurveSceneOptions", field, value, constraint);
 }
 
 bool inRange(double value, double low, double high) { return value >= low && value <= high; }
@@ -240,7 +233,7 @@ PolyBezier placeCurve(CurveKind kind, const CurveSceneOptions& options,
     if (isPlaceable(curve, options, camera_centres)) return curve;
   }
   throw InvalidOptions("CurveSceneOptions", "min_camera_distance",
-                       formatValue(options.min_camera_distance),
+                       formatOptionValue(options.min_camera_distance),
                        "no curve fits in the volume this far from every keyframe after " +
                            std::to_string(kMaxPlacementAttempts) + " attempts");
 }

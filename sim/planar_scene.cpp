@@ -23,10 +23,7 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr int kMaxImageSide = 16384;
 
 void require(bool ok, const char* field, double value, const char* constraint) {
-  if (ok) return;
-  std::ostringstream text;
-  text << value;
-  throw InvalidOptions("PlanarSceneOptions", field, text.str(), constraint);
+  requireOption(ok, "PlanarSceneOptions", field, value, constraint);
 }
 
 void checkTexture(const cv::Mat& texture) {

@@ -1,6 +1,7 @@
 #include "apps/cli_options.h"
 
 #include <algorithm>
+#include <fstream>
 #include <initializer_list>
 #include <memory>
 
@@ -269,6 +270,20 @@ nlohmann::json summaryToJson(const OptimizationSummary& summary) {
         {"writeback", summary.writeback_seconds},
         {"total", summary.total_seconds}}},
   };
+}
+
+nlohmann::json sampleCountsToJson(const CurveSampleCounts& counts) {
+  return {{"on_field", counts.on_field},
+          {"behind_camera", counts.behind_camera},
+          {"outside_image", counts.outside_image},
+          {"beyond_reach", counts.beyond_reach},
+          {"wrong_orientation", counts.wrong_orientation},
+          {"total", counts.total()}};
+}
+
+void writeJsonFile(const std::string& path, const nlohmann::json& json) {
+  std::ofstream out(path);
+  if (!(out << json.dump(2) << "\n")) throw IoError(path, "cannot write");
 }
 
 }  // namespace curvesfm

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "factors/curve_reprojection_factor.h"
 #include "graph/optimizer.h"
 #include "graph/robust_kernel.h"
 #include "graph/scheduler.h"
@@ -113,5 +114,11 @@ nlohmann::json schedulerOptionsToJson(const SchedulerOptions& options);
 /// A ScheduleReport as a JSON object: totals, stop reason, warnings and every phase with its
 /// solver summary (for report.json).
 nlohmann::json scheduleReportToJson(const ScheduleReport& report);
+
+/// Where curve samples fall (CurveSampleCounts) as a JSON object with a total.
+nlohmann::json sampleCountsToJson(const CurveSampleCounts& counts);
+
+/// Writes `json` (indented) to `path`; IoError naming the path if it cannot.
+void writeJsonFile(const std::string& path, const nlohmann::json& json);
 
 }  // namespace curvesfm

@@ -127,12 +127,6 @@ nlohmann::json objectiveOptionsToJson(const CurveBundleAdjustmentOptions& o) {
           {"scale_sigma", o.scale_sigma}};
 }
 
-int countSegments(const std::vector<PolyBezier>& curves) {
-  int segments = 0;
-  for (const PolyBezier& curve : curves) segments += curve.numSegments();
-  return segments;
-}
-
 int countPartlyHidden(const CurveScene& scene) {
   int hidden = 0;
   for (const CurveObservation& obs : scene.observations) hidden += obs.partlyHidden();
@@ -144,14 +138,14 @@ void printScene(const CurveScene& scene, const CurveSceneOptions& options) {
       "scene: %zu keyframes (%s), %zu curves (%s, %d segments), %zu observations "
       "(%d partly hidden), seed %u\n",
       scene.keyframes.size(), toString(options.camera_path).c_str(), scene.true_curves.size(),
-      toString(options.curve_kind).c_str(), countSegments(scene.true_curves),
+      toString(options.curve_kind).c_str(), totalSegments(scene.true_curves),
       scene.observations.size(), countPartlyHidden(scene), options.seed);
 }
 
 nlohmann::json sceneCountsToJson(const CurveScene& scene) {
   return {{"keyframes", scene.keyframes.size()},
           {"curves", scene.true_curves.size()},
-          {"segments", countSegments(scene.true_curves)},
+          {"segments", totalSegments(scene.true_curves)},
           {"observations", scene.observations.size()},
           {"partly_hidden_observations", countPartlyHidden(scene)}};
 }
@@ -180,15 +174,6 @@ void printSamples(const char* label, const CurveSampleCounts& s) {
       label, s.on_field, s.behind_camera, s.outside_image, s.beyond_reach, s.wrong_orientation);
 }
 
-nlohmann::json samplesToJson(const CurveSampleCounts& s) {
-  return {{"on_field", s.on_field},
-          {"behind_camera", s.behind_camera},
-          {"outside_image", s.outside_image},
-          {"beyond_reach", s.beyond_reach},
-          {"wrong_orientation", s.wrong_orientation},
-          {"total", s.total()}};
-}
-
 // Ceres' IsSolutionUsable for every phase that ran.
 bool allSolvesUsable(const ScheduleReport& report) {
   for (const ScheduleRound& round : report.rounds) {
@@ -214,13 +199,12 @@ Snapshot snapshot(const CurveScene& scene, const CurveBundleAdjustmentProblem& p
 
 nlohmann::json snapshotToJson(const Snapshot& s) {
   return {{"errors", errorsToJson(s.errors)},
-          {"samples", samplesToJson(s.samples)},
+          {"samples", sampleCountsToJson(s.samples)},
           {"cost_by_type", costsToJson(s.costs)}};
 }
 
 void writeReport(const std::string& path, const nlohmann::json& report) {
-  std::ofstream out(path);
-  if (!(out << report.dump(2) << "\n")) throw IoError(path, "cannot write the report");
+  writeJsonFile(path, report);
   std::printf("report: %s\n", path.c_str());
 }
 

@@ -85,11 +85,6 @@ nlohmann::json perPoseToJson(const TrajectoryEvaluation& e) {
   return poses;
 }
 
-void writeJson(const std::string& path, const nlohmann::json& report) {
-  std::ofstream out(path);
-  if (!(out << report.dump(2) << "\n")) throw IoError(path, "cannot write the report");
-}
-
 }  // namespace
 
 EvalCommand::EvalCommand(CLI::App* app) {
@@ -133,7 +128,7 @@ int EvalCommand::run() const {
   printStatistics(evaluation);
 
   if (!json_path_.empty()) {
-    writeJson(
+    writeJsonFile(
         json_path_,
         {{"command", "eval"},
          {"config", optionsToJson(*command_)},

@@ -8,6 +8,7 @@
 #include "apps/curve_ba_command.h"
 #include "apps/eval_command.h"
 #include "apps/point_ba_command.h"
+#include "apps/run_command.h"
 #include "apps/synth_command.h"
 #include "core/errors.h"
 
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
   curvesfm::CurveBaCommand curve_ba(&app);
   curvesfm::EvalCommand eval(&app);
   curvesfm::SynthCommand synth(&app);
+  curvesfm::RunCommand run(&app);
 
   try {
     curvesfm::parseCommandLine(&app, std::vector<std::string>(argv + 1, argv + argc));
@@ -29,6 +31,7 @@ int main(int argc, char** argv) {
     if (curve_ba.selected()) curve_ba.validate();
     if (eval.selected()) eval.validate();
     if (synth.selected()) synth.validate();
+    if (run.selected()) run.validate();
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
@@ -42,6 +45,7 @@ int main(int argc, char** argv) {
     if (curve_ba.selected()) return curve_ba.run();
     if (eval.selected()) return eval.run();
     if (synth.selected()) return synth.run();
+    if (run.selected()) return run.run();
   } catch (const curvesfm::Error& e) {
     std::cerr << e.what() << "\n";
     return 1;

@@ -94,8 +94,7 @@ int PointBaCommand::run() const {
         {"errors_after", errorsToJson(after)},
         {"optimizer", summaryToJson(summary)},
     };
-    std::ofstream out(report_path_);
-    if (!(out << report.dump(2) << "\n")) throw IoError(report_path_, "cannot write the report");
+    writeJsonFile(report_path_, report);
     std::printf("report: %s\n", report_path_.c_str());
   }
   return summary.usable ? 0 : 1;

@@ -151,4 +151,10 @@ std::vector<Eigen::Vector3d> PolyBezier::sample(int samples_per_segment) const {
   return samples;
 }
 
+int totalSegments(const std::vector<PolyBezier>& curves) {
+  int segments = 0;
+  for (const PolyBezier& curve : curves) segments += curve.numSegments();
+  return segments;
+}
+
 }  // namespace curvesfm

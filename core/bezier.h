@@ -188,4 +188,7 @@ class PolyBezier {
   std::vector<SegmentLengths> lengths_;
 };
 
+/// The number of segments of all `curves` together.
+int totalSegments(const std::vector<PolyBezier>& curves);
+
 }  // namespace curvesfm

@@ -1,0 +1,41 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "frontend/curve_overlay.h"
+#include "frontend/pipeline.h"
+
+namespace curvesfm {
+
+/// `curvesfm run`: the incremental curve SfM pipeline on a dataset in the TUM RGB-D layout
+/// (DESIGN.md "Data contracts"): loads camera.yaml, rgb.txt and the initial poses, feeds the
+/// frames to Pipeline printing one line per keyframe, runs global BA and writes trajectory.txt,
+/// curves.ply, curves.obj, report.json, config.yaml (the flags in force, for --config) and, with
+/// --overlays, the curves reprojected onto each keyframe. With DIR/groundtruth.txt it prints the
+/// ATE (Sim(3)) of the initial and the refined keyframe trajectory. Every PipelineOptions field
+/// is a flag (and so a --config key), prefixed by its stage.
+class RunCommand {
+ public:
+  explicit RunCommand(CLI::App* app);
+  bool selected() const { return command_->parsed(); }
+  /// Throws InvalidOptions for an option out of range (main reports it as a usage error).
+  void validate() const;
+  /// Runs the command; returns the process exit code (1 if nothing was reconstructed or global
+  /// BA failed). Bad input files throw IoError or ParseError naming the file and line.
+  int run() const;
+
+ private:
+  CLI::App* command_;
+  std::string dataset_dir_;
+  std::string out_dir_;
+  std::string init_poses_path_;
+  bool overlays_ = false;
+  int export_samples_per_segment_ = 20;
+  /// Largest |t_image - t_pose| of an image matched to an initial pose (s).
+  double max_dt_ = 0.02;
+  PipelineOptions options_;
+  CurveOverlayOptions overlay_;
+};
+
+}  // namespace curvesfm

@@ -188,14 +188,6 @@ void addConfigFlag(CLI::App* command) {
 nlohmann::json optionsToJson(const CLI::App& command) {
   nlohmann::json json = nlohmann::json::object();
   for (const auto& [name, value] : effectiveOptions(command)) json[name] = value;
-  // effectiveOptions() lists every value given; the one in force is the last (a flag that
-  // overrides the config file), which reduced_results() applies.
-  for (const CLI::Option* option : command.get_options()) {
-    const std::vector<std::string>& names = option->get_lnames();
-    if (names.empty() || !json.contains(names.front()) || option->count() == 0) continue;
-    if (option->get_items_expected_max() == 0) continue;
-    json[names.front()] = CLI::detail::join(option->reduced_results(), " ");
-  }
   return json;
 }
 

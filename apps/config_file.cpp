@@ -78,7 +78,9 @@ std::vector<std::pair<std::string, std::string>> effectiveOptions(const CLI::App
     if (isFlag(*option)) {
       value = option->count() > 0 ? "true" : "false";
     } else if (option->count() > 0) {
-      for (const std::string& result : option->results()) {
+      // reduced_results() applies the multi-option policy: for a flag given in the config file
+      // and again on the command line, the value that won.
+      for (const std::string& result : option->reduced_results()) {
         value += (value.empty() ? "" : " ") + result;
       }
     } else {

@@ -16,7 +16,8 @@ namespace curvesfm {
 std::vector<std::string> configFileArguments(const std::string& path, const CLI::App& command);
 
 /// Every option of `command` with a long name (except help and config) and its effective value:
-/// as given on the command line or in the config file, else its default; in declaration order.
+/// the value in force (the command line over the config file, else the default), in declaration
+/// order.
 std::vector<std::pair<std::string, std::string>> effectiveOptions(const CLI::App& command);
 
 /// effectiveOptions() as YAML that configFileArguments() reads back.

@@ -1,7 +1,5 @@
 #include "apps/run_command.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -546,20 +544,10 @@ nlohmann::json ateToJson(const AteResult& ate) {
           {"problem", ate.problem}};
 }
 
-// The flags in force, as a --config file, in --help order. Not effectiveOptionsYaml(): it joins
-// every value given, and a flag from both the config file and the command line must be written
-// with the value that won, which optionsToJson() gives.
 void writeConfigYaml(const std::string& path, const CLI::App& command) {
-  const nlohmann::json in_force = optionsToJson(command);
-  YAML::Emitter yaml;
-  yaml << YAML::BeginMap;
-  for (const auto& option : effectiveOptions(command)) {
-    yaml << YAML::Key << option.first << YAML::Value << in_force[option.first].get<std::string>();
-  }
-  yaml << YAML::EndMap;
   std::ofstream out(path);
   if (!(out << "# curvesfm run: the options in force; rerun with --config " << path << "\n"
-            << yaml.c_str() << "\n")) {
+            << effectiveOptionsYaml(command))) {
     throw IoError(path, "cannot write");
   }
 }

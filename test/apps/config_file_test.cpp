@@ -85,5 +85,14 @@ TEST_F(ConfigFileTest, EffectiveOptionsRoundTripThroughYaml) {
   EXPECT_EQ(args[1], "3");
 }
 
+TEST_F(ConfigFileTest, EffectiveOptionsGiveTheValueInForce) {
+  // As in curvesfm: a flag from the config file and again on the command line, the last wins.
+  command_->get_option("--max-iterations")->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app_.parse(std::vector<std::string>{"9", "--max-iterations", "3", "--max-iterations", "demo"});
+  EXPECT_EQ(iterations_, 9);
+  const std::string yaml = effectiveOptionsYaml(*command_);
+  EXPECT_NE(yaml.find("max-iterations: 9\n"), std::string::npos) << yaml;
+}
+
 }  // namespace
 }  // namespace curvesfm

@@ -282,6 +282,9 @@ OptionFields pipelineFields(PipelineOptions* o) {
       {
           boolean(g, "run_global_ba", "run-global-ba", &o->run_global_ba,
                   "Run global BA after the last frame"),
+          number(g, "reassociation_rounds", "reassociation-rounds", &o->reassociation_rounds,
+                 "After global BA: rounds of re-registering every curve in every keyframe, each "
+                 "followed by global BA (0: none)"),
           number(g, "depth_reference_candidates", "depth-reference-candidates",
                  &o->depth_reference_candidates, "Recent keyframes considered as depth references"),
           boolean(g, "track_keyframe_pose", "track-keyframe-pose", &o->track_keyframe_pose,
@@ -421,10 +424,13 @@ double secondsSince(Clock::time_point start) {
 
 void printProgress(const KeyframeStats& s, int frames) {
   std::printf(
-      "frame %d/%d keyframe %d: curves %d global / %d temporary, registered %d (rejected %d), "
-      "new %d, frontend %.0f ms, local BA %.0f ms\n",
+      "frame %d/%d keyframe %d: curves %d global / %d temporary, registered %d (rejected %d: "
+      "%d duplicate, %d edge distance, %d appearance, %d other), new %d, frontend %.0f ms, "
+      "local BA %.0f ms\n",
       s.frame_index + 1, frames, s.keyframe_index, s.global_curves, s.temporary_curves,
-      s.registered_segments, s.rejected_segments, s.new_curves, 1e3 * s.frontendSeconds(),
+      s.registered_segments, s.rejected_segments, s.rejected_duplicate, s.rejected_edge_distance,
+      s.rejected_appearance, s.rejected_depth + s.rejected_viewing_direction, s.new_curves,
+      1e3 * s.frontendSeconds(),
       1e3 * s.local_ba_seconds);
   std::fflush(stdout);
 }
@@ -508,7 +514,13 @@ nlohmann::json frameToJson(const KeyframeStats& s) {
       {"chains", s.chains},
       {"valid_depths", s.valid_depths},
       {"registered_segments", s.registered_segments},
-      {"rejected_segments", s.rejected_segments},
+      {"rejected_segments",
+       {{"total", s.rejected_segments},
+        {"duplicate", s.rejected_duplicate},
+        {"depth", s.rejected_depth},
+        {"edge_distance", s.rejected_edge_distance},
+        {"viewing_direction", s.rejected_viewing_direction},
+        {"appearance", s.rejected_appearance}}},
       {"new_curves", s.new_curves},
       {"global_curves", s.global_curves},
       {"temporary_curves", s.temporary_curves},
@@ -581,13 +593,30 @@ void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
                 r.global_ba.initial_cost, r.global_ba.final_cost, r.global_ba.total_iterations,
                 r.global_ba.total_seconds, r.global_ba.stop_reason.c_str());
   }
+  double global_seconds = r.global_ba.total_seconds;
+  for (std::size_t i = 0; i < r.reassociation.size(); ++i) {
+    const ScheduleReport& ba = r.reassociation[i].global_ba;
+    std::printf("re-association %zu: %d observations added, global BA cost %.6g -> %.6g, %.2f s\n",
+                i + 1, r.reassociation[i].added_observations, ba.initial_cost, ba.final_cost,
+                ba.total_seconds);
+    global_seconds += ba.total_seconds;
+  }
   std::printf(
       "samples: %d on field, %d behind camera, %d outside image, %d beyond reach, %d wrong "
       "orientation\n",
       samples.on_field, samples.behind_camera, samples.outside_image, samples.beyond_reach,
       samples.wrong_orientation);
   std::printf("time: frontend %.2f s, local BA %.2f s, global BA %.2f s, total %.2f s\n", frontend,
-              local_ba, r.global_ba.total_seconds, seconds);
+              local_ba, global_seconds, seconds);
+}
+
+nlohmann::json reassociationToJson(const std::vector<ReassociationRound>& rounds) {
+  nlohmann::json json = nlohmann::json::array();
+  for (const ReassociationRound& round : rounds) {
+    json.push_back({{"added_observations", round.added_observations},
+                    {"global_ba", scheduleReportToJson(round.global_ba)}});
+  }
+  return json;
 }
 
 bool globalBaUsable(const ScheduleReport& report) {
@@ -698,6 +727,7 @@ int RunCommand::run() const {
              {"frames", frames},
              {"global_ba", scheduleReportToJson(result.global_ba)},
              {"global_ba_cost_by_type", globalCostsToJson(result.global_ba)},
+             {"reassociation", reassociationToJson(result.reassociation)},
              {"final_samples", sampleCountsToJson(result.final_samples)},
              {"ate", ateToJson(ate)},
              {"total_seconds", seconds}});
@@ -712,9 +742,15 @@ int RunCommand::run() const {
                  "the keyframe lines and report.json)\n");
     return 1;
   }
-  if (!globalBaUsable(result.global_ba)) {
-    std::fprintf(stderr, "run: global BA failed: %s\n", result.global_ba.stop_reason.c_str());
-    return 1;
+  std::vector<const ScheduleReport*> global_solves = {&result.global_ba};
+  for (const ReassociationRound& round : result.reassociation) {
+    global_solves.push_back(&round.global_ba);
+  }
+  for (const ScheduleReport* report : global_solves) {
+    if (!globalBaUsable(*report)) {
+      std::fprintf(stderr, "run: global BA failed: %s\n", report->stop_reason.c_str());
+      return 1;
+    }
   }
   return 0;
 }

@@ -30,8 +30,12 @@ void printSummary(const std::string& image_path, const std::string& out_dir,
               1e3 * scene.firstToLastBaseline());
   std::printf("noise: intensity std dev %.2f levels (%g x 255) per pixel and channel, seed %u\n",
               options.intensity_noise * 255.0, options.intensity_noise, options.seed);
-  std::printf("initial poses: every frame perturbed, std dev %g m and %g deg per axis\n",
-              options.init_noise_translation, options.init_noise_rotation_deg);
+  std::printf("initial poses: %s, std dev %g m and %g deg per axis %s\n",
+              options.init_noise_model == InitNoiseModel::kDrift
+                  ? "drift (every motion between frames perturbed)"
+                  : "every frame perturbed on its own",
+              options.init_noise_translation, options.init_noise_rotation_deg,
+              options.init_noise_model == InitNoiseModel::kDrift ? "per step" : "per pose");
   std::printf(
       "written: %s (rgb.txt, rgb/ with %zu PNG, camera.yaml, groundtruth.txt, "
       "init_poses.txt)\n",
@@ -67,11 +71,17 @@ SynthCommand::SynthCommand(CLI::App* app) {
       ->capture_default_str();
   c->add_option("--seed", options_.seed, "Random seed of the noise and the initial poses")
       ->capture_default_str();
+  addEnumFlag(c, "init-noise-model", &options_.init_noise_model, parseInitNoiseModel,
+              "Initial poses: independent (every pose perturbed on its own) or drift (every "
+              "motion between consecutive frames perturbed, errors accumulate as in visual "
+              "odometry)");
   c->add_option("--init-noise-trans", options_.init_noise_translation,
-                "Initial poses: std dev per axis of the camera-centre error (m)")
+                "Initial poses: std dev per axis of the camera-centre error (m), per pose or, "
+                "with drift, per step")
       ->capture_default_str();
   c->add_option("--init-noise-rot", options_.init_noise_rotation_deg,
-                "Initial poses: std dev per axis of the rotation error (deg)")
+                "Initial poses: std dev per axis of the rotation error (deg), per pose or, with "
+                "drift, per step")
       ->capture_default_str();
   c->add_option("--width", options_.width, "Image width (px); the principal point is centred")
       ->capture_default_str();

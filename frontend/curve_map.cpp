@@ -137,16 +137,17 @@ void CurveMap::addObservation(int id, int segment, const ObservedSegmentAppearan
       << " segments)";
   MapSegment& s = c.segments[segment];
   const int keyframe = observation.observation.keyframe;
-  if (!s.observations.empty()) {
-    const int last = s.observations.back().observation.keyframe;
-    if (last == keyframe) return;
-    CURVESFM_CHECK(last < keyframe) << "observation of curve " << id << " segment " << segment
-                                    << " in keyframe " << keyframe << " after keyframe " << last;
-  }
+  CURVESFM_CHECK(keyframe >= 0) << "observation of curve " << id << " segment " << segment
+                                << " in keyframe " << keyframe;
+  // Usually the newest keyframe; re-association after bundle adjustment adds earlier ones.
+  const auto at = std::lower_bound(
+      s.observations.begin(), s.observations.end(), keyframe,
+      [](const ObservedSegmentAppearance& o, int k) { return o.observation.keyframe < k; });
+  if (at != s.observations.end() && at->observation.keyframe == keyframe) return;
   ObservedSegmentAppearance stored = observation;
   stored.observation.curve = id;
   stored.observation.segment = segment;
-  s.observations.push_back(stored);
+  s.observations.insert(at, stored);
   s.viewing.add(observation.viewing_direction_in_world);
 }
 

@@ -115,6 +115,17 @@ int dominantReference(const std::vector<PixelDepth>& depths, const PixelRange& r
   return best;
 }
 
+void countRejection(CorrespondenceCheck failed, KeyframeStats* stats) {
+  ++stats->rejected_segments;
+  switch (failed) {
+    case CorrespondenceCheck::kDepth: ++stats->rejected_depth; break;
+    case CorrespondenceCheck::kEdgeDistance: ++stats->rejected_edge_distance; break;
+    case CorrespondenceCheck::kViewingDirection: ++stats->rejected_viewing_direction; break;
+    case CorrespondenceCheck::kAppearance: ++stats->rejected_appearance; break;
+    case CorrespondenceCheck::kNone: break;
+  }
+}
+
 void requireDepthCandidates(int value) {
   requireOption(value >= 1, "PipelineOptions", "depth_reference_candidates", value, ">= 1");
 }
@@ -143,6 +154,8 @@ void PipelineOptions::validate() const {
   global_ba.validate();
   tracking.validate();
   requireDepthCandidates(depth_reference_candidates);
+  requireOption(reassociation_rounds >= 0, "PipelineOptions", "reassociation_rounds",
+                reassociation_rounds, ">= 0");
   requireOption(std::isfinite(explained_radius_px) && explained_radius_px >= 0.0, "PipelineOptions",
                 "explained_radius_px", explained_radius_px, "must be finite and >= 0");
 }
@@ -163,6 +176,7 @@ struct Pipeline::Impl {
   void registerTier(int k, CurveState state, bool skip_explained, cv::Mat* explained,
                     KeyframeStats* stats);
   void registerMap(int k, cv::Mat* explained, KeyframeStats* stats);
+  int reassociate();
   std::vector<int> depthReferences(int k, const std::vector<EdgeChain>& chains) const;
   void initialiseCurves(int k, const std::vector<EdgeChain>& chains, KeyframeStats* stats);
   void addNewCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
@@ -218,16 +232,15 @@ void Pipeline::Impl::trackPose(Keyframe* keyframe) {
   input.camera = camera;
   input.cam_from_world = {keyframe->cam_from_world};
   input.fields = {keyframe->field};
-  for (const CurveState state : {CurveState::kGlobal, CurveState::kTemporary}) {
-    for (const int id : map.curvesIn(state)) {
-      const PolyBezier& curve = map.curve(id).curve;
-      const int exported = static_cast<int>(input.curves.size());
-      input.curves.push_back(curve);
-      for (int i = 0; i < curve.numSegments(); ++i) {
-        if (checkPositiveDepth(curve.segment(i), keyframe->cam_from_world, options.correspondence)
-                .passed) {
-          input.observations.push_back({exported, i, 0});
-        }
+  // Global curves only: temporary ones come straight from depth and were never refined.
+  for (const int id : map.curvesIn(CurveState::kGlobal)) {
+    const PolyBezier& curve = map.curve(id).curve;
+    const int exported = static_cast<int>(input.curves.size());
+    input.curves.push_back(curve);
+    for (int i = 0; i < curve.numSegments(); ++i) {
+      if (checkPositiveDepth(curve.segment(i), keyframe->cam_from_world, options.correspondence)
+              .passed) {
+        input.observations.push_back({exported, i, 0});
       }
     }
   }
@@ -263,12 +276,13 @@ void Pipeline::Impl::registerTier(int k, CurveState state, bool skip_explained, 
       // A lower tier must not take over edges a higher one explains: duplicates of a curve.
       if (skip_explained && fractionOnMask(polyline, *explained) > 0.5) {
         ++stats->rejected_segments;
+        ++stats->rejected_duplicate;
         continue;
       }
       const CorrespondenceVerdict verdict =
           registerSegment(segment, view, curve.segments[i].history(), options.correspondence);
       if (!verdict.registered) {
-        ++stats->rejected_segments;
+        countRejection(verdict.failed_check, stats);
         continue;
       }
       ObservedSegmentAppearance o;
@@ -289,6 +303,32 @@ void Pipeline::Impl::registerMap(int k, cv::Mat* explained, KeyframeStats* stats
   registerTier(k, CurveState::kGlobal, false, explained, stats);
   registerTier(k, CurveState::kTemporary, true, explained, stats);
   registerTier(k, CurveState::kDisabled, true, explained, stats);
+}
+
+// Registers every promoted curve's segments in every keyframe that does not observe them yet,
+// with the same four checks, at the refined poses and curves. Returns the observations added.
+int Pipeline::Impl::reassociate() {
+  int added = 0;
+  std::vector<int> ids = map.curvesIn(CurveState::kGlobal);
+  for (const int id : map.curvesIn(CurveState::kDisabled)) {
+    if (map.curve(id).promoted) ids.push_back(id);
+  }
+  for (int k = 0; k < static_cast<int>(keyframes.size()); ++k) {
+    const KeyframeView view = viewOf(keyframes[k], *camera);
+    for (const int id : ids) {
+      const MapCurve& curve = map.curve(id);
+      for (int i = 0; i < curve.curve.numSegments(); ++i) {
+        if (curve.segments[i].observedIn(k)) continue;
+        const CorrespondenceVerdict verdict = registerSegment(
+            curve.curve.segment(i), view, curve.segments[i].history(), options.correspondence);
+        if (!verdict.registered) continue;
+        map.addObservation(id, i,
+                           {{id, i, k}, verdict.appearance, verdict.viewing_direction_in_world});
+        ++added;
+      }
+    }
+  }
+  return added;
 }
 
 std::vector<int> Pipeline::Impl::depthReferences(int k,
@@ -443,6 +483,14 @@ PipelineResult Pipeline::finish() {
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
     result.global_ba =
         impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba, &result.final_samples);
+    for (int r = 0; r < impl.options.reassociation_rounds; ++r) {
+      ReassociationRound round;
+      round.added_observations = impl.reassociate();
+      if (round.added_observations == 0) break;
+      round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
+                                          &result.final_samples);
+      result.reassociation.push_back(std::move(round));
+    }
   }
   for (const Keyframe& keyframe : impl.keyframes) {
     result.keyframe_timestamps.push_back(keyframe.timestamp);

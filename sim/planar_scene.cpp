@@ -54,13 +54,34 @@ Pose3 orbitPose(const PlanarSceneOptions& options, int frame) {
 
 // An isotropic rotation error (so applying it in the world frame is the same as in the camera
 // frame) and a shift of the camera centre in the world.
-Pose3 perturb(const Pose3& cam_from_world, const PlanarSceneOptions& options, std::mt19937& rng) {
+Vector6d poseNoise(const PlanarSceneOptions& options, std::mt19937& rng) {
   std::normal_distribution<double> rotation(0.0, options.init_noise_rotation_deg * kDegToRad);
   std::normal_distribution<double> translation(0.0, options.init_noise_translation);
   Vector6d delta;
   for (int k = 0; k < 3; ++k) delta(k) = rotation(rng);
   for (int k = 3; k < 6; ++k) delta(k) = translation(rng);
+  return delta;
+}
+
+Pose3 perturb(const Pose3& cam_from_world, const Vector6d& delta) {
   return cam_from_world.inverse().retract(delta).inverse();
+}
+
+// The starting guess of every frame (see InitNoiseModel).
+std::vector<Pose3> initialPoses(const std::vector<Pose3>& truth, const PlanarSceneOptions& options,
+                                std::mt19937& rng) {
+  std::vector<Pose3> initial;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const Vector6d delta = poseNoise(options, rng);
+    if (options.init_noise_model == InitNoiseModel::kIndependent || i == 0) {
+      initial.push_back(perturb(truth[i], delta));
+      continue;
+    }
+    // The true motion from frame i-1 to i, perturbed, applied to the previous guess.
+    const Pose3 true_step = truth[i] * truth[i - 1].inverse();
+    initial.push_back(perturb(true_step * initial.back(), delta));
+  }
+  return initial;
 }
 
 void addIntensityNoise(double sigma, cv::RNG& rng, cv::Mat* image) {
@@ -214,6 +235,24 @@ double PlanarScene::firstToLastBaseline() const {
       .norm();
 }
 
+std::string toString(InitNoiseModel model) {
+  switch (model) {
+    case InitNoiseModel::kIndependent:
+      return "independent";
+    case InitNoiseModel::kDrift:
+      return "drift";
+  }
+  return "unknown";
+}
+
+InitNoiseModel parseInitNoiseModel(const std::string& name, const std::string& field) {
+  for (const InitNoiseModel model : {InitNoiseModel::kIndependent, InitNoiseModel::kDrift}) {
+    if (name == toString(model)) return model;
+  }
+  throw InvalidOptions("PlanarSceneOptions", field, "\"" + name + "\"",
+                       "expected one of independent, drift");
+}
+
 PlanarScene makePlanarScene(const cv::Mat& texture_bgr, const PlanarSceneOptions& options) {
   options.validate();
   PlanarScene scene;
@@ -223,10 +262,11 @@ PlanarScene makePlanarScene(const cv::Mat& texture_bgr, const PlanarSceneOptions
   std::mt19937 pose_rng(options.seed);
   cv::RNG noise_rng(options.seed);
   for (int i = 0; i < options.num_frames; ++i) {
-    const Pose3 truth = orbitPose(options, i);
     scene.timestamps.push_back(i * kPlanarFramePeriod);
-    scene.true_cam_from_world.push_back(truth);
-    scene.initial_cam_from_world.push_back(perturb(truth, options, pose_rng));
+    scene.true_cam_from_world.push_back(orbitPose(options, i));
+  }
+  scene.initial_cam_from_world = initialPoses(scene.true_cam_from_world, options, pose_rng);
+  for (const Pose3& truth : scene.true_cam_from_world) {
     cv::Mat image = renderPlanarView(texture_bgr, options.plane_width, *scene.camera, truth);
     addIntensityNoise(options.intensity_noise * 255.0, noise_rng, &image);
     scene.images.push_back(image);

@@ -169,6 +169,7 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   options.cx = 119.5;
   options.cy = 89.5;
   options.intensity_noise = 0.01;
+  options.init_noise_model = InitNoiseModel::kIndependent;
   options.init_noise_translation = 0.005;
   options.init_noise_rotation_deg = 0.2;
   const std::string dataset = path("planar");

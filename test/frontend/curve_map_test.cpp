@@ -57,6 +57,18 @@ TEST(CurveMap, RepeatedObservationInOneKeyframeCountsOnce) {
   EXPECT_THROW(map.addObservation(id, 2, seenIn(1)), CheckError);
 }
 
+// Re-association after bundle adjustment registers segments in earlier keyframes too.
+TEST(CurveMap, KeepsObservationsInKeyframeOrder) {
+  CurveMap map;
+  const int id = map.addCurve(straightCurve(1), 0);
+  for (const int keyframe : {4, 1, 6, 1, 3}) map.addObservation(id, 0, seenIn(keyframe));
+  std::vector<int> keyframes;
+  for (const auto& o : map.curve(id).segments[0].observations) {
+    keyframes.push_back(o.observation.keyframe);
+  }
+  EXPECT_EQ(keyframes, (std::vector<int>{1, 3, 4, 6}));
+}
+
 TEST(CurveMap, DisablesWhenMoreThanHalfUnseenOverThreeKeyframes) {
   CurveMap map;
   const int id = map.addCurve(straightCurve(4), 0);

@@ -59,9 +59,7 @@ PlanarSceneOptions smallOrbit() {
   options.fx = options.fy = 262.5;
   options.cx = 159.5;
   options.cy = 119.5;
-  options.intensity_noise = 0.01;
-  options.init_noise_translation = 0.01;
-  options.init_noise_rotation_deg = 0.3;
+  options.intensity_noise = 0.01;  // The initial poses drift as synth planar's default.
   options.seed = 3;
   return options;
 }
@@ -85,9 +83,9 @@ TEST(Pipeline, RefinesAPerturbedPlanarTrajectory) {
   const double refined_ate =
       evaluateTrajectory(scene.true_cam_from_world, result.keyframe_cam_from_world)
           .position_ate_sim3;
-  // Local and global bundle adjustment must leave the trajectory closer to the truth than the
-  // perturbed start.
-  EXPECT_LT(refined_ate, initial_ate)
+  // Bundle adjustment and re-association must leave the trajectory clearly closer to the truth
+  // than the drifting start.
+  EXPECT_LT(refined_ate, 0.5 * initial_ate)
       << "initial ATE " << initial_ate << " m, refined " << refined_ate << " m";
 }
 

@@ -256,13 +256,20 @@ TEST(PlanarScene, SameSeedGivesTheSameScene) {
   }
 }
 
-TEST(PlanarScene, InitialPosesDifferFromTruthByTheAskedNoise) {
+// 400 tiny views whose initial poses carry the given error: enough frames for error statistics.
+PlanarSceneOptions manyTinyViews(InitNoiseModel model, double translation, double rotation_deg) {
   PlanarSceneOptions options = smallOptions();
   options.width = 16;
   options.height = 12;
   options.num_frames = 400;
-  options.init_noise_translation = 0.02;
-  options.init_noise_rotation_deg = 1.0;
+  options.init_noise_model = model;
+  options.init_noise_translation = translation;
+  options.init_noise_rotation_deg = rotation_deg;
+  return options;
+}
+
+TEST(PlanarScene, InitialPosesDifferFromTruthByTheAskedNoise) {
+  PlanarSceneOptions options = manyTinyViews(InitNoiseModel::kIndependent, 0.02, 1.0);
   const PlanarScene scene = makePlanarScene(smoothTexture(16, 12), options);
   double centre_squares = 0.0, angle_squares = 0.0;
   for (int i = 0; i < options.num_frames; ++i) {
@@ -281,6 +288,35 @@ TEST(PlanarScene, InitialPosesDifferFromTruthByTheAskedNoise) {
   const PlanarScene exact = makePlanarScene(smoothTexture(16, 12), options);
   EXPECT_TRUE(exact.initial_cam_from_world[0].translation().isApprox(
       exact.true_cam_from_world[0].translation()));
+}
+
+// Drift: the error of every motion between consecutive frames has the asked std dev, and the
+// errors of the poses accumulate like a random walk.
+TEST(PlanarScene, DriftPerturbsEveryStepAndAccumulates) {
+  const PlanarSceneOptions options = manyTinyViews(InitNoiseModel::kDrift, 0.001, 0.05);
+  const PlanarScene scene = makePlanarScene(smoothTexture(16, 12), options);
+  double angle_squares = 0.0;
+  for (int i = 1; i < options.num_frames; ++i) {
+    const Pose3 true_step =
+        scene.true_cam_from_world[i] * scene.true_cam_from_world[i - 1].inverse();
+    const Pose3 initial_step =
+        scene.initial_cam_from_world[i] * scene.initial_cam_from_world[i - 1].inverse();
+    angle_squares += std::pow(initial_step.rotation().angularDistance(true_step.rotation()), 2);
+  }
+  EXPECT_NEAR(std::sqrt(angle_squares / (3 * (options.num_frames - 1))) * 180 / M_PI, 0.05,
+              0.05 * 0.07);
+  // A random walk: the rotation error after n steps grows like sqrt(n) times a step's.
+  const auto rotation_error = [&](int i) {
+    return scene.initial_cam_from_world[i].rotation().angularDistance(
+        scene.true_cam_from_world[i].rotation());
+  };
+  double early = 0.0, late = 0.0;
+  for (int i = 0; i < 20; ++i) early += rotation_error(i) / 20;
+  for (int i = 380; i < 400; ++i) late += rotation_error(i) / 20;
+  EXPECT_GT(late, 3 * early);
+  EXPECT_EQ(parseInitNoiseModel("drift", "f"), InitNoiseModel::kDrift);
+  EXPECT_EQ(toString(InitNoiseModel::kIndependent), "independent");
+  EXPECT_THROW(parseInitNoiseModel("gaussian", "f"), InvalidOptions);
 }
 
 class PlanarDatasetTest : public ::testing::Test {

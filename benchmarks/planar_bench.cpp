@@ -19,16 +19,20 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "benchmarks/support/bench_common.h"
@@ -72,6 +76,9 @@ struct BenchOptions {
   double init_translation_m = PlanarSceneOptions().init_noise_translation;  ///< Per axis (m).
   double init_rotation_deg = PlanarSceneOptions().init_noise_rotation_deg;  ///< Per axis (deg).
   bool quick = false;                ///< 2 photos x 2 noise levels x 10 frames.
+  /// Cases run at once, one thread each (each case is single-threaded); per-stage times are
+  /// wall times, so more jobs than idle cores inflate them.
+  int jobs = 1;
 };
 
 struct LoadedPhoto {
@@ -463,14 +470,25 @@ int run(const BenchOptions& options, const std::string& command) {
   for (const LoadedPhoto& p : photos)
     std::printf("# photo %s: %s\n", p.photo.file.c_str(), p.photo.category.c_str());
 
-  std::vector<CaseResult> results;
-  const int total = static_cast<int>(photos.size() * noises.size());
+  std::vector<std::pair<const LoadedPhoto*, int>> cases;
   for (const LoadedPhoto& photo : photos) {
-    for (int noise : noises) {
-      results.push_back(runCase(photo, noise, options));
-      printProgress(results.back(), static_cast<int>(results.size()), total);
-    }
+    for (int noise : noises) cases.emplace_back(&photo, noise);
   }
+  std::vector<CaseResult> results(cases.size());
+  std::atomic<std::size_t> next{0};
+  int done = 0;
+  std::mutex progress;
+  const auto worker = [&]() {
+    for (std::size_t i = next++; i < cases.size(); i = next++) {
+      results[i] = runCase(*cases[i].first, cases[i].second, options);
+      const std::lock_guard<std::mutex> lock(progress);
+      printProgress(results[i], ++done, static_cast<int>(cases.size()));
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int j = 1; j < options.jobs; ++j) threads.emplace_back(worker);
+  worker();
+  for (std::thread& thread : threads) thread.join();
 
   writeCsv(results, out / "runs.csv");
   writeSummary(results, options, command, out / "summary.md");
@@ -513,6 +531,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
   app.add_flag("--quick", options.quick, "2 photos x 2 noise levels x 10 frames (smoke test)");
+  app.add_option("--jobs", options.jobs,
+                 "Cases run at once (one thread each; stage times are wall times)")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   const std::string command = curvesfm::commandLine(argc, argv);
   return curvesfm::bench::parseAndRun(app, argc, argv, [&] {
     if (options.quick) options.frames = std::min(options.frames, 10);

@@ -198,6 +198,13 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_EQ(report["options"]["pipeline"]["global_ba"]["optimizer"]["max_iterations"], 10);
   EXPECT_EQ(report["options"]["pipeline"]["map"]["min_keyframe_translation"], 0.0);
   EXPECT_TRUE(report["global_ba"].contains("rounds"));
+  EXPECT_EQ(report["options"]["pipeline"]["pipeline"]["reassociation_rounds"], 3);
+  ASSERT_TRUE(report["reassociation"].is_array());
+  for (const auto& round : report["reassociation"]) {
+    EXPECT_GT(round["added_observations"].get<int>(), 0);
+    EXPECT_TRUE(round["global_ba"].contains("rounds"));
+  }
+  EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));
   EXPECT_TRUE(report["ate"]["refined_m"].contains("rmse"));
 
   // config.yaml holds every flag in force: a rerun from it alone writes the same keyframes.

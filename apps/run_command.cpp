@@ -576,6 +576,32 @@ void printAte(const AteResult& ate, const std::string& ground_truth_path) {
   }
 }
 
+// Mean per-stage frontend time over the keyframes (ms), and the slowest keyframe's total: the
+// frontend budget is per keyframe, local BA is reported apart.
+void printFrontendStages(const std::vector<KeyframeStats>& frames) {
+  double undistort = 0.0, edges = 0.0, field = 0.0, depth = 0.0, correspondence = 0.0,
+         initialise = 0.0, slowest = 0.0;
+  int keyframes = 0;
+  for (const KeyframeStats& s : frames) {
+    if (s.keyframe_index < 0) continue;
+    ++keyframes;
+    undistort += s.undistort_seconds;
+    edges += s.edges_seconds;
+    field += s.field_seconds;
+    depth += s.depth_seconds;
+    correspondence += s.correspondence_seconds;
+    initialise += s.initialise_seconds;
+    slowest = std::max(slowest, s.frontendSeconds());
+  }
+  if (keyframes == 0) return;
+  const double ms = 1e3 / keyframes;
+  std::printf(
+      "frontend per keyframe (mean ms): undistort %.1f, edges %.1f, field %.1f, depth %.1f, "
+      "correspondence %.1f, initialise %.1f; total %.1f, slowest keyframe %.1f\n",
+      undistort * ms, edges * ms, field * ms, depth * ms, correspondence * ms, initialise * ms,
+      (undistort + edges + field + depth + correspondence + initialise) * ms, 1e3 * slowest);
+}
+
 void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
   double frontend = 0.0, local_ba = 0.0;
   for (const KeyframeStats& s : r.frames) {
@@ -608,6 +634,7 @@ void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
       samples.wrong_orientation);
   std::printf("time: frontend %.2f s, local BA %.2f s, global BA %.2f s, total %.2f s\n", frontend,
               local_ba, global_seconds, seconds);
+  printFrontendStages(r.frames);
 }
 
 nlohmann::json reassociationToJson(const std::vector<ReassociationRound>& rounds) {

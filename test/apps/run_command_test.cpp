@@ -184,6 +184,7 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_THAT(result.output, HasSubstr("frame 6/6 keyframe 5: curves "));
   EXPECT_THAT(result.output, HasSubstr("run: 6 frames (0 of 6 images without an initial pose"));
   EXPECT_THAT(result.output, HasSubstr("ATE (sim3) vs " + dataset + "/groundtruth.txt"));
+  EXPECT_THAT(result.output, HasSubstr("frontend per keyframe (mean ms): undistort "));
 
   EXPECT_EQ(readTrajectory(out + "/trajectory.txt").size(), 6u);
   for (const char* name : {"curves.ply", "curves.obj", "config.yaml", "overlays/000005.png"}) {

@@ -141,8 +141,9 @@ struct PlanarScene {
 /// Builds the scene from the photo `texture_bgr` (CV_8UC1 or CV_8UC3): cameras evenly spaced on
 /// the orbit arc (see PlanarSceneOptions), each looking at the photo's centre with its image x
 /// axis horizontal, renderPlanarView() views with Gaussian noise (cv::RNG, `seed`) added per
-/// pixel and channel, and perturbed initial poses (an isotropic Gaussian rotation-vector error
-/// and a Gaussian shift of the camera centre in the world; std::mt19937, `seed`). All images are
+/// pixel and channel, and perturbed initial poses (per pose or per step, see InitNoiseModel: an
+/// isotropic Gaussian rotation-vector error and a Gaussian shift of the camera centre in the
+/// world; std::mt19937, `seed`). All images are
 /// held in memory (width x height x channels bytes each). Throws InvalidOptions for invalid
 /// options, CheckError for an empty or non-8-bit texture.
 PlanarScene makePlanarScene(const cv::Mat& texture_bgr, const PlanarSceneOptions& options);

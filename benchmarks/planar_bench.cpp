@@ -521,6 +521,7 @@ int main(int argc, char** argv) {
            options.init_noise_model = curvesfm::parseInitNoiseModel(name, "init_noise_model");
          },
          "Initial pose error: drift (per step, accumulating) or independent (per pose)")
+      ->check(CLI::IsMember({"drift", "independent"}))
       ->default_str(curvesfm::toString(options.init_noise_model));
   app.add_option("--init-translation", options.init_translation_m,
                  "Std dev of the initial camera-centre error (m), per step or per pose")

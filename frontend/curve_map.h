@@ -124,9 +124,9 @@ class CurveMap {
   /// Adds a temporary curve initialised in `keyframe`, without observations; returns its id.
   int addCurve(const PolyBezier& curve, int keyframe);
   /// Records that segment `segment` of curve `id` was registered in `observation.keyframe`, with
-  /// the appearance and viewing direction measured there. The keyframe must not precede the
-  /// segment's last observation; a second registration in the same keyframe is ignored.
-  /// Throws CheckError on a bad id, segment or order.
+  /// the appearance and viewing direction measured there. Observations stay in keyframe order
+  /// (re-association adds earlier keyframes); a second registration in the same keyframe is
+  /// ignored. Throws CheckError on a bad id, segment or a negative keyframe.
   void addObservation(int id, int segment, const ObservedSegmentAppearance& observation);
 
   /// Ends keyframe `keyframe` (all its observations added): disabled curves seen in it are

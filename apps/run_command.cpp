@@ -428,10 +428,9 @@ void printProgress(const KeyframeStats& s, int frames) {
       "%d duplicate, %d edge distance, %d appearance, %d other), new %d, frontend %.0f ms, "
       "local BA %.0f ms\n",
       s.frame_index + 1, frames, s.keyframe_index, s.global_curves, s.temporary_curves,
-      s.registered_segments, s.rejected_segments, s.rejected_duplicate, s.rejected_edge_distance,
+      s.registered_segments, s.rejectedSegments(), s.rejected_duplicate, s.rejected_edge_distance,
       s.rejected_appearance, s.rejected_depth + s.rejected_viewing_direction, s.new_curves,
-      1e3 * s.frontendSeconds(),
-      1e3 * s.local_ba_seconds);
+      1e3 * s.frontendSeconds(), 1e3 * s.local_ba_seconds);
   std::fflush(stdout);
 }
 
@@ -515,7 +514,7 @@ nlohmann::json frameToJson(const KeyframeStats& s) {
       {"valid_depths", s.valid_depths},
       {"registered_segments", s.registered_segments},
       {"rejected_segments",
-       {{"total", s.rejected_segments},
+       {{"total", s.rejectedSegments()},
         {"duplicate", s.rejected_duplicate},
         {"depth", s.rejected_depth},
         {"edge_distance", s.rejected_edge_distance},
@@ -576,30 +575,15 @@ void printAte(const AteResult& ate, const std::string& ground_truth_path) {
   }
 }
 
-// Mean per-stage frontend time over the keyframes (ms), and the slowest keyframe's total: the
-// frontend budget is per keyframe, local BA is reported apart.
+// The frontend budget is per keyframe; local BA is reported apart.
 void printFrontendStages(const std::vector<KeyframeStats>& frames) {
-  double undistort = 0.0, edges = 0.0, field = 0.0, depth = 0.0, correspondence = 0.0,
-         initialise = 0.0, slowest = 0.0;
-  int keyframes = 0;
-  for (const KeyframeStats& s : frames) {
-    if (s.keyframe_index < 0) continue;
-    ++keyframes;
-    undistort += s.undistort_seconds;
-    edges += s.edges_seconds;
-    field += s.field_seconds;
-    depth += s.depth_seconds;
-    correspondence += s.correspondence_seconds;
-    initialise += s.initialise_seconds;
-    slowest = std::max(slowest, s.frontendSeconds());
-  }
-  if (keyframes == 0) return;
-  const double ms = 1e3 / keyframes;
+  const KeyframeTimes t = keyframeTimes(frames);
+  if (t.keyframes == 0) return;
   std::printf(
       "frontend per keyframe (mean ms): undistort %.1f, edges %.1f, field %.1f, depth %.1f, "
       "correspondence %.1f, initialise %.1f; total %.1f, slowest keyframe %.1f\n",
-      undistort * ms, edges * ms, field * ms, depth * ms, correspondence * ms, initialise * ms,
-      (undistort + edges + field + depth + correspondence + initialise) * ms, 1e3 * slowest);
+      t.undistort_ms, t.edges_ms, t.field_ms, t.depth_ms, t.correspondence_ms, t.initialise_ms,
+      t.frontend_ms, t.slowest_frontend_ms);
 }
 
 void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
@@ -619,13 +603,11 @@ void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
                 r.global_ba.initial_cost, r.global_ba.final_cost, r.global_ba.total_iterations,
                 r.global_ba.total_seconds, r.global_ba.stop_reason.c_str());
   }
-  double global_seconds = r.global_ba.total_seconds;
   for (std::size_t i = 0; i < r.reassociation.size(); ++i) {
     const ScheduleReport& ba = r.reassociation[i].global_ba;
     std::printf("re-association %zu: %d observations added, global BA cost %.6g -> %.6g, %.2f s\n",
                 i + 1, r.reassociation[i].added_observations, ba.initial_cost, ba.final_cost,
                 ba.total_seconds);
-    global_seconds += ba.total_seconds;
   }
   std::printf(
       "samples: %d on field, %d behind camera, %d outside image, %d beyond reach, %d wrong "
@@ -633,7 +615,7 @@ void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
       samples.on_field, samples.behind_camera, samples.outside_image, samples.beyond_reach,
       samples.wrong_orientation);
   std::printf("time: frontend %.2f s, local BA %.2f s, global BA %.2f s, total %.2f s\n", frontend,
-              local_ba, global_seconds, seconds);
+              local_ba, r.globalBaSeconds(), seconds);
   printFrontendStages(r.frames);
 }
 
@@ -731,33 +713,33 @@ int RunCommand::run() const {
   for (const KeyframeStats& s : result.frames) frames.push_back(frameToJson(s));
   const double seconds = secondsSince(start);
   writeJsonFile(joinPath(out_dir_, "report.json"),
-            {{"command", "run"},
-             {"config", optionsToJson(*command_)},
-             {"options",
-              {{"pipeline", pipelineOptionsToJson(options_)},
-               {"overlay", overlayOptionsToJson(overlay_)},
-               {"export_samples_per_segment", export_samples_per_segment_}}},
-             {"dataset",
-              {{"dir", dataset_dir_},
-               {"camera", d.camera_path},
-               {"rgb", d.rgb_path},
-               {"init_poses", d.init_poses_path},
-               {"groundtruth", d.ground_truth_path},
-               {"images", d.images},
-               {"frames_with_initial_pose", d.frames.size()}}},
-             {"counts",
-              {{"frames", d.frames.size()},
-               {"keyframes", result.keyframe_cam_from_world.size()},
-               {"curves", result.curves.size()},
-               {"segments", totalSegments(result.curves)},
-               {"overlays", overlays}}},
-             {"frames", frames},
-             {"global_ba", scheduleReportToJson(result.global_ba)},
-             {"global_ba_cost_by_type", globalCostsToJson(result.global_ba)},
-             {"reassociation", reassociationToJson(result.reassociation)},
-             {"final_samples", sampleCountsToJson(result.final_samples)},
-             {"ate", ateToJson(ate)},
-             {"total_seconds", seconds}});
+                {{"command", "run"},
+                 {"config", optionsToJson(*command_)},
+                 {"options",
+                  {{"pipeline", pipelineOptionsToJson(options_)},
+                   {"overlay", overlayOptionsToJson(overlay_)},
+                   {"export_samples_per_segment", export_samples_per_segment_}}},
+                 {"dataset",
+                  {{"dir", dataset_dir_},
+                   {"camera", d.camera_path},
+                   {"rgb", d.rgb_path},
+                   {"init_poses", d.init_poses_path},
+                   {"groundtruth", d.ground_truth_path},
+                   {"images", d.images},
+                   {"frames_with_initial_pose", d.frames.size()}}},
+                 {"counts",
+                  {{"frames", d.frames.size()},
+                   {"keyframes", result.keyframe_cam_from_world.size()},
+                   {"curves", result.curves.size()},
+                   {"segments", totalSegments(result.curves)},
+                   {"overlays", overlays}}},
+                 {"frames", frames},
+                 {"global_ba", scheduleReportToJson(result.global_ba)},
+                 {"global_ba_cost_by_type", globalCostsToJson(result.global_ba)},
+                 {"reassociation", reassociationToJson(result.reassociation)},
+                 {"final_samples", sampleCountsToJson(result.final_samples)},
+                 {"ate", ateToJson(ate)},
+                 {"total_seconds", seconds}});
 
   printSummary(d, result, seconds);
   printAte(ate, d.ground_truth_path);

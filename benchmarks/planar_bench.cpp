@@ -70,12 +70,12 @@ const std::array<std::array<double, 5>, 4> kPaperTable2Mm = {{{0.415, 0.312, 0.4
 struct BenchOptions {
   std::string data_dir = "/usr/share/doc/opencv-doc/examples/data";  ///< Folder of the photos.
   std::string out = "bench_out/planar";                              ///< Output folder (created).
-  int frames = 30;                   ///< Rendered views per case; >= 3.
+  int frames = 30;  ///< Rendered views per case; >= 3.
   // The initial pose error; sim/planar_scene.h's defaults, as `curvesfm synth planar`.
   InitNoiseModel init_noise_model = PlanarSceneOptions().init_noise_model;
   double init_translation_m = PlanarSceneOptions().init_noise_translation;  ///< Per axis (m).
   double init_rotation_deg = PlanarSceneOptions().init_noise_rotation_deg;  ///< Per axis (deg).
-  bool quick = false;                ///< 2 photos x 2 noise levels x 10 frames.
+  bool quick = false;  ///< 2 photos x 2 noise levels x 10 frames.
   /// Cases run at once, one thread each (each case is single-threaded); per-stage times are
   /// wall times, so more jobs than idle cores inflate them.
   int jobs = 1;
@@ -88,17 +88,6 @@ struct LoadedPhoto {
 };
 
 // Mean per-keyframe wall time of each stage (ms), in KeyframeStats order.
-struct StageMeans {
-  double undistort = 0.0;
-  double edges = 0.0;
-  double field = 0.0;
-  double depth = 0.0;
-  double correspondence = 0.0;
-  double initialise = 0.0;
-  double frontend = 0.0;  ///< Sum of the six above.
-  double local_ba = 0.0;
-};
-
 struct CaseResult {
   std::string photo;
   std::string category;
@@ -109,7 +98,7 @@ struct CaseResult {
   int global_curves = 0;
   double initial_ate_mm = std::nan("");
   double refined_ate_mm = std::nan("");
-  StageMeans stages;
+  KeyframeTimes stages;  ///< Per keyframe.
   double global_ba_seconds = 0.0;
   double case_seconds = 0.0;
   std::string error;  ///< Empty unless the pipeline threw.
@@ -137,26 +126,6 @@ std::vector<LoadedPhoto> loadPhotos(const BenchOptions& options) {
   return loaded;
 }
 
-StageMeans meanStages(const std::vector<KeyframeStats>& keyframes) {
-  StageMeans m;
-  for (const KeyframeStats& k : keyframes) {
-    m.undistort += k.undistort_seconds;
-    m.edges += k.edges_seconds;
-    m.field += k.field_seconds;
-    m.depth += k.depth_seconds;
-    m.correspondence += k.correspondence_seconds;
-    m.initialise += k.initialise_seconds;
-    m.frontend += k.frontendSeconds();
-    m.local_ba += k.local_ba_seconds;
-  }
-  const double scale = keyframes.empty() ? 0.0 : 1e3 / keyframes.size();
-  for (double* v : {&m.undistort, &m.edges, &m.field, &m.depth, &m.correspondence, &m.initialise,
-                    &m.frontend, &m.local_ba}) {
-    *v *= scale;
-  }
-  return m;
-}
-
 // Runs the pipeline over the scene; fills keyframe counts, ATEs and timings of `result`.
 void runPipeline(const PlanarScene& scene, CaseResult* result) {
   Pipeline pipeline(*scene.camera, PipelineOptions{});
@@ -179,11 +148,8 @@ void runPipeline(const PlanarScene& scene, CaseResult* result) {
       1e3 * evaluateTrajectory(truth, out.keyframe_initial_cam_from_world).position_ate_sim3;
   result->refined_ate_mm =
       1e3 * evaluateTrajectory(truth, out.keyframe_cam_from_world).position_ate_sim3;
-  result->stages = meanStages(keyframes);
-  result->global_ba_seconds = out.global_ba.total_seconds;
-  for (const ReassociationRound& round : out.reassociation) {
-    result->global_ba_seconds += round.global_ba.total_seconds;
-  }
+  result->stages = keyframeTimes(keyframes);
+  result->global_ba_seconds = out.globalBaSeconds();
 }
 
 CaseResult runCase(const LoadedPhoto& photo, int noise_percent, const BenchOptions& options) {
@@ -221,8 +187,8 @@ void printProgress(const CaseResult& r, int done, int total) {
                "[%d/%d] %s (%s) noise %d %%: %d kf, %d curves, ATE %.2f -> %.2f mm, frontend "
                "%.1f ms/kf, local BA %.1f ms/kf, global BA %.1f s, %.1f s\n",
                done, total, r.photo.c_str(), r.category.c_str(), r.noise_percent, r.keyframes,
-               r.global_curves, r.initial_ate_mm, r.refined_ate_mm, r.stages.frontend,
-               r.stages.local_ba, r.global_ba_seconds, r.case_seconds);
+               r.global_curves, r.initial_ate_mm, r.refined_ate_mm, r.stages.frontend_ms,
+               r.stages.local_ba_ms, r.global_ba_seconds, r.case_seconds);
 }
 
 void writeCsv(const std::vector<CaseResult>& results, const std::filesystem::path& path) {
@@ -232,13 +198,14 @@ void writeCsv(const std::vector<CaseResult>& results, const std::filesystem::pat
          "refined_ate_mm,ratio,improved,undistort_ms,edges_ms,field_ms,depth_ms,"
          "correspondence_ms,initialise_ms,frontend_ms,local_ba_ms,global_ba_s,case_s,error\n";
   for (const CaseResult& r : results) {
-    const StageMeans& s = r.stages;
+    const KeyframeTimes& s = r.stages;
     out << r.photo << "," << r.category << "," << r.noise_percent << "," << r.seed << ","
         << r.frames << "," << r.keyframes << "," << r.global_curves << "," << r.initial_ate_mm
         << "," << r.refined_ate_mm << "," << r.ratio() << "," << (r.improved() ? 1 : 0) << ","
-        << s.undistort << "," << s.edges << "," << s.field << "," << s.depth << ","
-        << s.correspondence << "," << s.initialise << "," << s.frontend << "," << s.local_ba << ","
-        << r.global_ba_seconds << "," << r.case_seconds << ",\"" << r.error << "\"\n";
+        << s.undistort_ms << "," << s.edges_ms << "," << s.field_ms << "," << s.depth_ms << ","
+        << s.correspondence_ms << "," << s.initialise_ms << "," << s.frontend_ms << ","
+        << s.local_ba_ms << "," << r.global_ba_seconds << "," << r.case_seconds << ",\"" << r.error
+        << "\"\n";
   }
 }
 
@@ -253,7 +220,7 @@ std::string tableRow(const CaseResult& r) {
                 "| %s | %s | %d | %.2f | %.2f | %.2f%s | %d | %d | %.1f | %.1f |", r.photo.c_str(),
                 r.category.c_str(), r.noise_percent, r.initial_ate_mm, r.refined_ate_mm, r.ratio(),
                 r.improved() ? "" : " (not improved)", r.keyframes, r.global_curves,
-                r.stages.frontend, r.stages.local_ba);
+                r.stages.frontend_ms, r.stages.local_ba_ms);
   return line;
 }
 
@@ -312,11 +279,12 @@ std::string stageTable(const std::vector<CaseResult>& results) {
   char line[256];
   for (const CaseResult& r : results) {
     if (!r.ok()) continue;
-    const StageMeans& s = r.stages;
+    const KeyframeTimes& s = r.stages;
     std::snprintf(line, sizeof(line),
                   "| %s | %d | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %.2f |\n",
-                  r.photo.c_str(), r.noise_percent, s.undistort, s.edges, s.field, s.depth,
-                  s.correspondence, s.initialise, s.frontend, s.local_ba, r.global_ba_seconds);
+                  r.photo.c_str(), r.noise_percent, s.undistort_ms, s.edges_ms, s.field_ms,
+                  s.depth_ms, s.correspondence_ms, s.initialise_ms, s.frontend_ms, s.local_ba_ms,
+                  r.global_ba_seconds);
     out << line;
   }
   return out.str();
@@ -421,8 +389,8 @@ void printHeadlines(const std::vector<CaseResult>& results) {
   for (const CaseResult& r : results) {
     improved += r.improved() ? 1 : 0;
     if (!r.ok()) continue;
-    frontend_ms.push_back(r.stages.frontend);
-    local_ba_ms.push_back(r.stages.local_ba);
+    frontend_ms.push_back(r.stages.frontend_ms);
+    local_ba_ms.push_back(r.stages.local_ba_ms);
   }
   std::printf("planar_cases_improved: %d of %zu\n", improved, results.size());
   bench::printInt("planar_cases_failed",
@@ -436,13 +404,13 @@ void printHeadlines(const std::vector<CaseResult>& results) {
 
 // The stages' medians over the cases, so the budget can be read per stage.
 void printStageMedians(const std::vector<CaseResult>& results) {
-  const std::vector<std::pair<std::string, double StageMeans::*>> stages = {
-      {"undistort", &StageMeans::undistort},
-      {"edges", &StageMeans::edges},
-      {"field", &StageMeans::field},
-      {"depth", &StageMeans::depth},
-      {"correspondence", &StageMeans::correspondence},
-      {"initialise", &StageMeans::initialise}};
+  const std::vector<std::pair<std::string, double KeyframeTimes::*>> stages = {
+      {"undistort", &KeyframeTimes::undistort_ms},
+      {"edges", &KeyframeTimes::edges_ms},
+      {"field", &KeyframeTimes::field_ms},
+      {"depth", &KeyframeTimes::depth_ms},
+      {"correspondence", &KeyframeTimes::correspondence_ms},
+      {"initialise", &KeyframeTimes::initialise_ms}};
   for (const auto& [name, member] : stages) {
     std::vector<double> ms;
     for (const CaseResult& r : results) {

@@ -48,6 +48,12 @@ ObservedSegmentAppearance measureSegment(const BezierSegmentParams& segment, int
   return o;
 }
 
+// What the map stores of a registration of segment `segment` of curve `id` in `keyframe`.
+ObservedSegmentAppearance registration(int id, int segment, int keyframe,
+                                       const CorrespondenceVerdict& verdict) {
+  return {{id, segment, keyframe}, verdict.appearance, verdict.viewing_direction_in_world};
+}
+
 // The projection of a segment as a polyline, or empty if part of it is behind the camera.
 std::vector<cv::Point> projectSegment(const BezierSegmentParams& segment,
                                       const Pose3& cam_from_world, const Camera& camera,
@@ -116,13 +122,21 @@ int dominantReference(const std::vector<PixelDepth>& depths, const PixelRange& r
 }
 
 void countRejection(CorrespondenceCheck failed, KeyframeStats* stats) {
-  ++stats->rejected_segments;
   switch (failed) {
-    case CorrespondenceCheck::kDepth: ++stats->rejected_depth; break;
-    case CorrespondenceCheck::kEdgeDistance: ++stats->rejected_edge_distance; break;
-    case CorrespondenceCheck::kViewingDirection: ++stats->rejected_viewing_direction; break;
-    case CorrespondenceCheck::kAppearance: ++stats->rejected_appearance; break;
-    case CorrespondenceCheck::kNone: break;
+    case CorrespondenceCheck::kDepth:
+      ++stats->rejected_depth;
+      break;
+    case CorrespondenceCheck::kEdgeDistance:
+      ++stats->rejected_edge_distance;
+      break;
+    case CorrespondenceCheck::kViewingDirection:
+      ++stats->rejected_viewing_direction;
+      break;
+    case CorrespondenceCheck::kAppearance:
+      ++stats->rejected_appearance;
+      break;
+    case CorrespondenceCheck::kNone:
+      break;
   }
 }
 
@@ -275,7 +289,6 @@ void Pipeline::Impl::registerTier(int k, CurveState state, bool skip_explained, 
           projectSegment(segment, keyframe.cam_from_world, *camera, samples);
       // A lower tier must not take over edges a higher one explains: duplicates of a curve.
       if (skip_explained && fractionOnMask(polyline, *explained) > 0.5) {
-        ++stats->rejected_segments;
         ++stats->rejected_duplicate;
         continue;
       }
@@ -285,11 +298,7 @@ void Pipeline::Impl::registerTier(int k, CurveState state, bool skip_explained, 
         countRejection(verdict.failed_check, stats);
         continue;
       }
-      ObservedSegmentAppearance o;
-      o.observation.keyframe = k;
-      o.appearance = verdict.appearance;
-      o.viewing_direction_in_world = verdict.viewing_direction_in_world;
-      map.addObservation(id, i, o);
+      map.addObservation(id, i, registration(id, i, k, verdict));
       ++stats->registered_segments;
       if (!polyline.empty()) registered.push_back(std::move(polyline));
     }
@@ -322,8 +331,7 @@ int Pipeline::Impl::reassociate() {
         const CorrespondenceVerdict verdict = registerSegment(
             curve.curve.segment(i), view, curve.segments[i].history(), options.correspondence);
         if (!verdict.registered) continue;
-        map.addObservation(id, i,
-                           {{id, i, k}, verdict.appearance, verdict.viewing_direction_in_world});
+        map.addObservation(id, i, registration(id, i, k, verdict));
         ++added;
       }
     }
@@ -390,8 +398,7 @@ void Pipeline::Impl::addNewCurve(int k, const InitialCurve& initial, const Chain
       const CorrespondenceVerdict verdict =
           registerSegment(segment, viewOf(keyframes[j], *camera), history, options.correspondence);
       if (verdict.registered) {
-        map.addObservation(id, i,
-                           {{id, i, j}, verdict.appearance, verdict.viewing_direction_in_world});
+        map.addObservation(id, i, registration(id, i, j, verdict));
       }
     }
     map.addObservation(id, i, here);
@@ -466,6 +473,35 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   stats.temporary_curves = map.count(CurveState::kTemporary);
   frames.push_back(stats);
   return stats;
+}
+
+KeyframeTimes keyframeTimes(const std::vector<KeyframeStats>& frames) {
+  KeyframeTimes t;
+  for (const KeyframeStats& s : frames) {
+    if (s.keyframe_index < 0) continue;
+    ++t.keyframes;
+    t.undistort_ms += s.undistort_seconds;
+    t.edges_ms += s.edges_seconds;
+    t.field_ms += s.field_seconds;
+    t.depth_ms += s.depth_seconds;
+    t.correspondence_ms += s.correspondence_seconds;
+    t.initialise_ms += s.initialise_seconds;
+    t.frontend_ms += s.frontendSeconds();
+    t.local_ba_ms += s.local_ba_seconds;
+    t.slowest_frontend_ms = std::max(t.slowest_frontend_ms, 1e3 * s.frontendSeconds());
+  }
+  const double ms_per_keyframe = t.keyframes == 0 ? 0.0 : 1e3 / t.keyframes;
+  for (double* v : {&t.undistort_ms, &t.edges_ms, &t.field_ms, &t.depth_ms, &t.correspondence_ms,
+                    &t.initialise_ms, &t.frontend_ms, &t.local_ba_ms}) {
+    *v *= ms_per_keyframe;
+  }
+  return t;
+}
+
+double PipelineResult::globalBaSeconds() const {
+  double seconds = global_ba.total_seconds;
+  for (const ReassociationRound& round : reassociation) seconds += round.global_ba.total_seconds;
+  return seconds;
 }
 
 Pipeline::Pipeline(const Camera& camera, const PipelineOptions& options)

@@ -33,12 +33,12 @@ struct PipelineOptions {
   EpipolarDepthOptions depth;
   CurveInitialiserOptions initialiser;
   CorrespondenceOptions correspondence;
-  CurveMapOptions map;                  ///< Promotion, disabling, keyframe selection.
-  CurveBundleAdjustmentOptions ba;      ///< The objective of local and global BA.
+  CurveMapOptions map;              ///< Promotion, disabling, keyframe selection.
+  CurveBundleAdjustmentOptions ba;  ///< The objective of local and global BA.
   /// After each keyframe (alternating, local scope, window 5).
   SchedulerOptions local_ba = defaultLocalBundleAdjustmentOptions();
-  SchedulerOptions global_ba;           ///< Once at the end (global scope).
-  bool run_global_ba = true;            ///< Run global BA in finish().
+  SchedulerOptions global_ba;  ///< Once at the end (global scope).
+  bool run_global_ba = true;   ///< Run global BA in finish().
   /// After global BA, rounds of re-association, each followed by global BA again: every
   /// promoted curve's segments are checked (registerSegment) in every keyframe that has no
   /// observation of them, at the refined poses and curves. Tracks then span the baselines that
@@ -72,18 +72,18 @@ struct PipelineOptions {
 /// One input image with its starting pose (from an initial trajectory).
 struct PipelineFrame {
   double timestamp = 0.0;
-  cv::Mat image_bgr;              ///< Colour image as loaded (distorted), CV_8UC3.
-  Pose3 initial_cam_from_world;   ///< Starting guess.
+  cv::Mat image_bgr;             ///< Colour image as loaded (distorted), CV_8UC3.
+  Pose3 initial_cam_from_world;  ///< Starting guess.
 };
 
 /// What happened to one frame (a progress line and a report.json entry).
 struct KeyframeStats {
-  int frame_index = 0;            ///< Index of the frame in the input sequence.
-  int keyframe_index = -1;        ///< -1 if the frame was not made a keyframe.
+  int frame_index = 0;      ///< Index of the frame in the input sequence.
+  int keyframe_index = -1;  ///< -1 if the frame was not made a keyframe.
   double timestamp = 0.0;
   // Per-stage wall time (s); the frontend budget covers all but local_ba_seconds.
   double undistort_seconds = 0.0;
-  double edges_seconds = 0.0;     ///< detectEdges + extractEdgeChains.
+  double edges_seconds = 0.0;  ///< detectEdges + extractEdgeChains.
   double field_seconds = 0.0;
   double depth_seconds = 0.0;
   double correspondence_seconds = 0.0;  ///< Pose tracking, projection and the four checks.
@@ -93,25 +93,48 @@ struct KeyframeStats {
   int edge_pixels = 0;
   int chains = 0;
   int valid_depths = 0;
-  int registered_segments = 0;    ///< Map segments registered in this keyframe.
-  int rejected_segments = 0;      ///< Map segments projected here and not registered (sum below).
-  /// Why: skipped as duplicates of edges a higher tier explained, or the first failed check.
+  int registered_segments = 0;  ///< Map segments registered in this keyframe.
+  /// Map segments projected here and not registered, by reason: skipped as duplicates of edges
+  /// a higher tier explained, or the first failed check (rejectedSegments() is their sum).
   int rejected_duplicate = 0;
   int rejected_depth = 0;
   int rejected_edge_distance = 0;
   int rejected_viewing_direction = 0;
   int rejected_appearance = 0;
   int new_curves = 0;
-  int global_curves = 0;          ///< Curves in the global map after this keyframe.
+  int global_curves = 0;  ///< Curves in the global map after this keyframe.
   int temporary_curves = 0;
   double local_ba_initial_cost = 0.0;
   double local_ba_final_cost = 0.0;
 
+  int rejectedSegments() const {
+    return rejected_duplicate + rejected_depth + rejected_edge_distance +
+           rejected_viewing_direction + rejected_appearance;
+  }
   double frontendSeconds() const {
     return undistort_seconds + edges_seconds + field_seconds + depth_seconds +
            correspondence_seconds + initialise_seconds;
   }
 };
+
+/// Per-stage time of the keyframes of a run: means per keyframe (ms), and the slowest
+/// keyframe's frontend time (the frontend budget is per keyframe; local BA is reported apart).
+struct KeyframeTimes {
+  int keyframes = 0;
+  double undistort_ms = 0.0;
+  double edges_ms = 0.0;
+  double field_ms = 0.0;
+  double depth_ms = 0.0;
+  double correspondence_ms = 0.0;
+  double initialise_ms = 0.0;
+  double frontend_ms = 0.0;  ///< Sum of the six above.
+  double local_ba_ms = 0.0;
+  double slowest_frontend_ms = 0.0;
+};
+
+/// The times of the keyframes among `frames` (frames that did not become keyframes are skipped);
+/// all zero without keyframes.
+KeyframeTimes keyframeTimes(const std::vector<KeyframeStats>& frames);
 
 /// One round of re-association after global BA (PipelineOptions::reassociation_rounds).
 struct ReassociationRound {
@@ -122,13 +145,16 @@ struct ReassociationRound {
 /// The result of a run: the refined keyframe trajectory and the global curve map.
 struct PipelineResult {
   std::vector<double> keyframe_timestamps;
-  std::vector<Pose3> keyframe_cam_from_world;     ///< Refined.
+  std::vector<Pose3> keyframe_cam_from_world;          ///< Refined.
   std::vector<Pose3> keyframe_initial_cam_from_world;  ///< As given.
-  std::vector<PolyBezier> curves;                 ///< Global map, world frame.
-  std::vector<KeyframeStats> frames;              ///< One per input frame.
-  ScheduleReport global_ba;                       ///< The first global BA; empty if not run.
-  std::vector<ReassociationRound> reassociation;  ///< In order; empty if none ran.
-  CurveSampleCounts final_samples;                ///< Where curve samples fall at the end.
+  std::vector<PolyBezier> curves;                      ///< Global map, world frame.
+  std::vector<KeyframeStats> frames;                   ///< One per input frame.
+  ScheduleReport global_ba;                            ///< The first global BA; empty if not run.
+  std::vector<ReassociationRound> reassociation;       ///< In order; empty if none ran.
+  CurveSampleCounts final_samples;                     ///< Where curve samples fall at the end.
+
+  /// Wall time of the first global BA and of the re-association rounds' (s).
+  double globalBaSeconds() const;
 };
 
 /// The incremental curve SfM pipeline: feed frames in order, then call finish(). Frames are

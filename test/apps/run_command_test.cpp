@@ -150,6 +150,9 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   CommandResult result = run("--edges-sobel-aperture 4");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("EdgeDetectorOptions.sobel_aperture = 4"));
+  result = run("--reassociation-rounds -1");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("PipelineOptions.reassociation_rounds = -1"));
   result = run("--local-ba-strategy sideways");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--local-ba-strategy"));

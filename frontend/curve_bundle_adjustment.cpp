@@ -6,6 +6,7 @@
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "factors/relative_pose_factor.h"
 #include "factors/segment_length_factor.h"
 #include "factors/tangent_alignment_factor.h"
 
@@ -54,14 +55,37 @@ void checkFields(const CurveBundleAdjustmentInput& input) {
   }
 }
 
+double meanStep(const std::vector<Pose3>& cam_from_world) {
+  double sum = 0.0;
+  for (std::size_t j = 1; j < cam_from_world.size(); ++j) {
+    sum += (cam_from_world[j].inverseTranslation() - cam_from_world[j - 1].inverseTranslation())
+               .norm();
+  }
+  return sum / static_cast<double>(cam_from_world.size() - 1);
+}
+
+void addMotionPrior(const std::vector<Pose3>& prior_cam_from_world,
+                    const CurveBundleAdjustmentOptions& options, FactorGraph* graph) {
+  if (prior_cam_from_world.size() < 2) return;
+  const double rotation_sigma = options.motion_prior_rotation_sigma_deg * M_PI / 180.0;
+  // A trajectory that never moves still gets a usable sigma: it pins the translations at zero.
+  const double translation_sigma =
+      options.motion_prior_translation_sigma_rel * std::max(meanStep(prior_cam_from_world), 1e-12);
+  for (std::size_t j = 1; j < prior_cam_from_world.size(); ++j) {
+    const Pose3 cam_j_from_cam_i = prior_cam_from_world[j] * prior_cam_from_world[j - 1].inverse();
+    graph->emplace<RelativePoseFactor>(poseKey(j - 1), poseKey(j), cam_j_from_cam_i, rotation_sigma,
+                                       translation_sigma);
+  }
+}
+
 }  // namespace
 
 void CurveBundleAdjustmentOptions::validate() const {
   const char* name = "CurveBundleAdjustmentOptions";
   if (samples_per_segment < 1 || samples_per_segment >= CurveReprojectionFactor::kMaxSamples) {
-    throw InvalidOptions(name, "samples_per_segment", std::to_string(samples_per_segment),
-                         "must be in [1, " +
-                             std::to_string(CurveReprojectionFactor::kMaxSamples - 1) + "]");
+    throw InvalidOptions(
+        name, "samples_per_segment", std::to_string(samples_per_segment),
+        "must be in [1, " + std::to_string(CurveReprojectionFactor::kMaxSamples - 1) + "]");
   }
   auto positive = [&](double value, const char* field) {
     if (!(value > 0.0 && std::isfinite(value))) {
@@ -82,6 +106,8 @@ void CurveBundleAdjustmentOptions::validate() const {
   non_negative(lambda1, "lambda1");
   non_negative(lambda2, "lambda2");
   positive(scale_sigma, "scale_sigma");
+  positive(motion_prior_rotation_sigma_deg, "motion_prior_rotation_sigma_deg");
+  positive(motion_prior_translation_sigma_rel, "motion_prior_translation_sigma_rel");
 }
 
 CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
@@ -91,7 +117,8 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
   checkFields(input);
   CurveBundleAdjustmentProblem problem;
   const int num_keyframes = static_cast<int>(input.cam_from_world.size());
-  for (int j = 0; j < num_keyframes; ++j) problem.values.insert(poseKey(j), input.cam_from_world[j]);
+  for (int j = 0; j < num_keyframes; ++j)
+    problem.values.insert(poseKey(j), input.cam_from_world[j]);
   for (std::size_t c = 0; c < input.curves.size(); ++c) {
     insertCurve(static_cast<std::uint32_t>(c), input.curves[c], &problem.values);
     addRegularisers(static_cast<std::uint32_t>(c), input.curves[c], options, &problem.graph);
@@ -106,9 +133,9 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
     CURVESFM_CHECK(obs.keyframe >= 0 && obs.keyframe < num_keyframes && obs.curve >= 0 &&
                    obs.curve < num_curves && obs.segment >= 0 &&
                    obs.segment < input.curves[obs.curve].numSegments())
-        << "observation of segment " << obs.segment << " of curve " << obs.curve
-        << " in keyframe " << obs.keyframe << " is out of range (" << num_curves << " curves, "
-        << num_keyframes << " keyframes)";
+        << "observation of segment " << obs.segment << " of curve " << obs.curve << " in keyframe "
+        << obs.keyframe << " is out of range (" << num_curves << " curves, " << num_keyframes
+        << " keyframes)";
     problem.graph.emplace<CurveReprojectionFactor>(
         poseKey(obs.keyframe), segmentKeys(obs.curve, obs.segment), input.fields[obs.keyframe],
         input.camera, sampling, pixel_noise);
@@ -116,8 +143,13 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
 
   if (options.fix_first_pose && num_keyframes > 0) problem.config.setConstant(poseKey(0));
   if (options.fix_scale) {
-    addScaleGauge(input.cam_from_world, input.scale_distance, options.scale_sigma,
-                  &problem.graph);
+    addScaleGauge(input.cam_from_world, input.scale_distance, options.scale_sigma, &problem.graph);
+  }
+  if (options.motion_prior && !input.motion_prior_cam_from_world.empty()) {
+    CURVESFM_CHECK(input.motion_prior_cam_from_world.size() == input.cam_from_world.size())
+        << "curve bundle adjustment: " << input.motion_prior_cam_from_world.size()
+        << " motion-prior poses for " << num_keyframes << " keyframes";
+    addMotionPrior(input.motion_prior_cam_from_world, options, &problem.graph);
   }
   return problem;
 }

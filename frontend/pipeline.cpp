@@ -197,7 +197,7 @@ struct Pipeline::Impl {
                    const std::vector<int>& reference_keyframes);
   CurveBundleAdjustmentInput bundleInput(CurveSelection selection, std::vector<int>* ids) const;
   ScheduleReport bundleAdjust(CurveSelection selection, const SchedulerOptions& scheduler,
-                              CurveSampleCounts* samples);
+                              bool refine_poses, CurveSampleCounts* samples);
 
   PipelineOptions options;
   ImageUndistorter undistorter;
@@ -411,6 +411,7 @@ CurveBundleAdjustmentInput Pipeline::Impl::bundleInput(CurveSelection selection,
   input.camera = camera;
   for (const Keyframe& keyframe : keyframes) {
     input.cam_from_world.push_back(keyframe.cam_from_world);
+    input.motion_prior_cam_from_world.push_back(keyframe.initial_cam_from_world);
     input.fields.push_back(keyframe.field);
   }
   // The scale gauge: the initial baseline of the first two keyframes, so the map keeps the unit
@@ -423,12 +424,13 @@ CurveBundleAdjustmentInput Pipeline::Impl::bundleInput(CurveSelection selection,
 }
 
 ScheduleReport Pipeline::Impl::bundleAdjust(CurveSelection selection,
-                                            const SchedulerOptions& scheduler,
+                                            const SchedulerOptions& scheduler, bool refine_poses,
                                             CurveSampleCounts* samples) {
   std::vector<int> ids;
   const CurveBundleAdjustmentInput input = bundleInput(selection, &ids);
   if (input.observations.empty()) return {};
   CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options.ba);
+  if (!refine_poses) problem.config.setConstant(VariableCategory::kPose);
   SchedulerOptions schedule = scheduler;
   schedule.fix_first_pose = options.ba.fix_first_pose;
   const ScheduleReport report =
@@ -464,7 +466,8 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   map.endKeyframe(k);
 
   if (keyframes.size() >= 2 && map.count(CurveState::kGlobal) > 0) {
-    const ScheduleReport report = bundleAdjust(CurveSelection::kGlobal, options.local_ba, nullptr);
+    const ScheduleReport report = bundleAdjust(CurveSelection::kGlobal, options.local_ba,
+                                               options.local_ba_refines_poses, nullptr);
     stats.local_ba_seconds = report.total_seconds;
     stats.local_ba_initial_cost = report.initial_cost;
     stats.local_ba_final_cost = report.final_cost;
@@ -517,13 +520,13 @@ PipelineResult Pipeline::finish() {
   impl.finished = true;
   PipelineResult result;
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
-    result.global_ba =
-        impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba, &result.final_samples);
+    result.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba, true,
+                                         &result.final_samples);
     for (int r = 0; r < impl.options.reassociation_rounds; ++r) {
       ReassociationRound round;
       round.added_observations = impl.reassociate();
       if (round.added_observations == 0) break;
-      round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
+      round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba, true,
                                           &result.final_samples);
       result.reassociation.push_back(std::move(round));
     }

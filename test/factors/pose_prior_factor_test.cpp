@@ -6,15 +6,12 @@
 
 #include "core/so3.h"
 #include "test/support/numerical_jacobian.h"
+#include "test/support/random_geometry.h"
 
 namespace curvesfm {
 namespace {
 
-Pose3 randomPose(std::mt19937& rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  return Pose3(so3::exp(Eigen::Vector3d(n(rng), n(rng), n(rng))),
-               Eigen::Vector3d(n(rng), n(rng), n(rng)));
-}
+using testing::randomPose;
 
 TEST(PosePriorFactor, ZeroAtThePriorAndHandComputedOffset) {
   const Pose3 prior(so3::exp(Eigen::Vector3d(0.1, 0.2, -0.3)), Eigen::Vector3d(1, 2, 3));

@@ -6,7 +6,6 @@
 #include <string>
 
 #include "core/errors.h"
-
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
 #include "sim/curve_scene_input.h"
@@ -30,9 +29,9 @@ Solved solve(const CurveScene& scene, Strategy strategy,
   Solved solved;
   solved.before = evaluateCurveScene(scene, input.cam_from_world, input.curves);
   solved.report = runSchedule(problem.graph, &problem.values, problem.config, scheduler);
-  solved.after = evaluateCurveScene(scene,
-                                    extractPoses(problem.values, input.cam_from_world.size()),
-                                    extractCurves(problem.values, input.curves));
+  solved.after =
+      evaluateCurveScene(scene, extractPoses(problem.values, input.cam_from_world.size()),
+                         extractCurves(problem.values, input.curves));
   return solved;
 }
 
@@ -98,8 +97,71 @@ TEST(CurveBundleAdjustment, PartlyHiddenCurvesAreNotBiasedWithTheOrientationChec
   const Solved checked = solve(scene, Strategy::kJoint, ba);
   EXPECT_LT(checked.after.curve_mean_error_aligned, 0.002);
   EXPECT_LT(checked.after.position_ate_sim3, 0.003);
-  EXPECT_LT(checked.after.curve_mean_error_aligned,
-            0.3 * unchecked.after.curve_mean_error_aligned);
+  EXPECT_LT(checked.after.curve_mean_error_aligned, 0.3 * unchecked.after.curve_mean_error_aligned);
+}
+
+int countFactors(const FactorGraph& graph, const std::string& type) {
+  int count = 0;
+  for (const auto& factor : graph) count += factor->typeName() == type;
+  return count;
+}
+
+TEST(CurveBundleAdjustment, MotionPriorTiesEachConsecutivePairOnlyWhenOnAndGiven) {
+  CurveSceneOptions scene_options;
+  scene_options.num_keyframes = 4;
+  const CurveScene scene = makeCurveScene(scene_options);
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, {}).graph, "relative_pose"), 0);
+  input.motion_prior_cam_from_world = scene.true_cam_from_world;
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, {}).graph, "relative_pose"), 3);
+  CurveBundleAdjustmentOptions off;
+  off.motion_prior = false;
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, off).graph, "relative_pose"), 0);
+  input.motion_prior_cam_from_world.pop_back();
+  EXPECT_THROW(buildCurveBundleAdjustment(input, {}), CheckError);
+}
+
+// The motion prior's cost when keyframe 2 of a trajectory scaled by `scale` is moved by
+// scale * 1 mm off it.
+double motionPriorCost(const CurveScene& scene, double scale) {
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  for (std::size_t j = 0; j < input.cam_from_world.size(); ++j) {
+    const Pose3& truth = scene.true_cam_from_world[j];
+    input.motion_prior_cam_from_world.push_back(
+        Pose3(truth.rotation(), scale * truth.translation()));
+    input.cam_from_world[j] = input.motion_prior_cam_from_world[j];
+  }
+  input.cam_from_world[2] = input.cam_from_world[2].retract(
+      (Vector6d() << 0, 0, 0, scale * 1e-3, 0, 0).finished());
+  const CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, {});
+  return problem.graph.costByType(problem.values).at("relative_pose").cost;
+}
+
+TEST(CurveBundleAdjustment, MotionPriorTranslationSigmaFollowsTheUnitOfThePoses) {
+  const CurveScene scene = makeCurveScene(perturbedScene());
+  const double cost = motionPriorCost(scene, 1.0);
+  EXPECT_GT(cost, 0.0);
+  EXPECT_NEAR(motionPriorCost(scene, 10.0), cost, 1e-9 * cost);
+}
+
+TEST(CurveBundleAdjustment, ATightMotionPriorKeepsThePriorsRelativeMotions) {
+  const CurveScene scene = makeCurveScene(perturbedScene());
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  input.motion_prior_cam_from_world = scene.true_cam_from_world;
+  CurveBundleAdjustmentOptions ba;
+  ba.motion_prior_rotation_sigma_deg = 1e-4;
+  ba.motion_prior_translation_sigma_rel = 1e-6;
+  CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
+  SchedulerOptions scheduler;
+  scheduler.optimizer.max_iterations = 100;
+  runSchedule(problem.graph, &problem.values, problem.config, scheduler);
+  const std::vector<Pose3> poses = extractPoses(problem.values, input.cam_from_world.size());
+  for (std::size_t j = 1; j < poses.size(); ++j) {
+    const Pose3 motion = poses[j] * poses[j - 1].inverse();
+    const Pose3 truth = scene.true_cam_from_world[j] * scene.true_cam_from_world[j - 1].inverse();
+    // The start is ~2 cm / 1 deg off per pose; the prior pins each motion to ~1e-6.
+    EXPECT_LT(truth.localCoordinates(motion).norm(), 1e-4) << "keyframes " << j - 1 << ", " << j;
+  }
 }
 
 TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
@@ -135,6 +197,12 @@ TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
   options = {};
   options.pixel_sigma = -1.0;
   expectRejected(options, "pixel_sigma");
+  options = {};
+  options.motion_prior_rotation_sigma_deg = 0.0;
+  expectRejected(options, "motion_prior_rotation_sigma_deg");
+  options = {};
+  options.motion_prior_translation_sigma_rel = std::nan("");
+  expectRejected(options, "motion_prior_translation_sigma_rel");
 }
 
 TEST(CurveBundleAdjustment, RejectsMismatchedFieldsAndObservationsOutOfRange) {

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -89,6 +90,36 @@ TEST(Pipeline, RefinesAPerturbedPlanarTrajectory) {
       << "initial ATE " << initial_ate << " m, refined " << refined_ate << " m";
 }
 
+// The largest camera-centre distance between the keyframe poses of a run without global BA and
+// the starting poses.
+double largestMoveWithoutGlobalBa(bool local_ba_refines_poses) {
+  PlanarSceneOptions orbit = smallOrbit();
+  orbit.num_frames = 5;  // Curves are global from keyframe 2 on: local BA runs from there.
+  const PlanarScene scene = makePlanarScene(planarTexture(), orbit);
+  PipelineOptions options;
+  options.map.min_keyframe_translation = 0.0;
+  options.map.min_keyframe_rotation_deg = 0.0;
+  options.run_global_ba = false;
+  options.local_ba_refines_poses = local_ba_refines_poses;
+  Pipeline pipeline(*scene.camera, options);
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
+  }
+  const PipelineResult result = pipeline.finish();
+  double largest = 0.0;
+  for (std::size_t j = 0; j < result.keyframe_cam_from_world.size(); ++j) {
+    largest = std::max(largest, (result.keyframe_cam_from_world[j].inverseTranslation() -
+                                 result.keyframe_initial_cam_from_world[j].inverseTranslation())
+                                    .norm());
+  }
+  return largest;
+}
+
+TEST(Pipeline, LocalBaMovesPosesOnlyWhenAskedTo) {
+  EXPECT_EQ(largestMoveWithoutGlobalBa(false), 0.0);
+  EXPECT_GT(largestMoveWithoutGlobalBa(true), 1e-5);
+}
+
 TEST(PipelineOptions, ValidateNamesTheStageAndField) {
   PipelineOptions options;
   options.depth_reference_candidates = 0;
@@ -100,6 +131,7 @@ TEST(PipelineOptions, ValidateNamesTheStageAndField) {
   EXPECT_THROW(options.validate(), InvalidOptions);
   EXPECT_EQ(PipelineOptions{}.local_ba.strategy, Strategy::kAlternating);
   EXPECT_EQ(PipelineOptions{}.local_ba.scope, Scope::kLocal);
+  EXPECT_FALSE(PipelineOptions{}.local_ba_refines_poses);
 }
 
 }  // namespace

@@ -5,9 +5,8 @@
 #include <initializer_list>
 #include <memory>
 
-#include "core/errors.h"
-
 #include "apps/config_file.h"
+#include "core/errors.h"
 
 namespace curvesfm {
 namespace {
@@ -27,12 +26,12 @@ Enum parseSceneEnum(const std::string& name, const std::string& field,
 
 // The selected (possibly nested) sub-command's --config file, or empty when none was given.
 std::string configPath(const CLI::App& app, const CLI::App** selected) {
+  const CLI::Option* config = app.get_option_no_throw("--config");
+  if (config && config->count() > 0) {
+    *selected = &app;
+    return config->as<std::string>();
+  }
   for (const CLI::App* command : app.get_subcommands()) {
-    const CLI::Option* config = command->get_option_no_throw("--config");
-    if (config && config->count() > 0) {
-      *selected = command;
-      return config->as<std::string>();
-    }
     const std::string nested = configPath(*command, selected);
     if (!nested.empty()) return nested;
   }
@@ -45,6 +44,7 @@ std::vector<std::string>::iterator afterCommandName(const CLI::App& command,
                                                     std::vector<std::string>* args) {
   auto begin = args->begin();
   const CLI::App* parent = command.get_parent();
+  if (!parent) return begin;  // A program without sub-commands: its flags start at once.
   if (parent && parent->get_parent()) begin = afterCommandName(*parent, args);
   return std::find(begin, args->end(), command.get_name()) + 1;
 }
@@ -88,14 +88,17 @@ void addOptimizerFlags(CLI::App* command, OptimizerOptions* options) {
   command->add_option("--max-iterations", options->max_iterations, "Maximum solver iterations")
       ->capture_default_str();
   command->add_option("--threads", options->num_threads, "Solver threads")->capture_default_str();
-  command->add_option("--function-tolerance", options->function_tolerance,
-                      "Stop when the relative cost change falls below this")
+  command
+      ->add_option("--function-tolerance", options->function_tolerance,
+                   "Stop when the relative cost change falls below this")
       ->capture_default_str();
-  command->add_option("--gradient-tolerance", options->gradient_tolerance,
-                      "Stop when the max gradient falls below this")
+  command
+      ->add_option("--gradient-tolerance", options->gradient_tolerance,
+                   "Stop when the max gradient falls below this")
       ->capture_default_str();
-  command->add_option("--parameter-tolerance", options->parameter_tolerance,
-                      "Stop when the relative step falls below this")
+  command
+      ->add_option("--parameter-tolerance", options->parameter_tolerance,
+                   "Stop when the relative step falls below this")
       ->capture_default_str();
   command->add_flag("!--no-structure-first", options->structure_first_ordering,
                     "Let Ceres choose the Schur elimination order");
@@ -121,8 +124,9 @@ void addSchedulerFlags(CLI::App* command, SchedulerOptions* options) {
       ->capture_default_str();
   command->add_option("--max-rounds", options->max_rounds, "Alternating: most rounds")
       ->capture_default_str();
-  command->add_option("--round-tolerance", options->round_tolerance,
-                      "Alternating: stop when a round lowers the cost by less than this fraction")
+  command
+      ->add_option("--round-tolerance", options->round_tolerance,
+                   "Alternating: stop when a round lowers the cost by less than this fraction")
       ->capture_default_str();
   addOptimizerFlags(command, &options->optimizer);
 }
@@ -181,8 +185,9 @@ void parseCommandLine(CLI::App* app, const std::vector<std::string>& args) {
 }
 
 void addConfigFlag(CLI::App* command) {
-  command->add_option("--config", "YAML file of options (keys are long flag names); flags given "
-                                  "on the command line override it");
+  command->add_option("--config",
+                      "YAML file of options (keys are long flag names); flags given "
+                      "on the command line override it");
 }
 
 nlohmann::json optionsToJson(const CLI::App& command) {

@@ -86,8 +86,8 @@ std::string toString(CurveKind kind);
 CameraPath parseCameraPath(const std::string& name, const std::string& field);
 CurveKind parseCurveKind(const std::string& name, const std::string& field);
 
-/// Parses `args` (without the program name) into `app`; if the selected sub-command (nested
-/// ones included, e.g. `synth planar`) got `--config FILE`, parses again with the file's flags
+/// Parses `args` (without the program name) into `app`; if `app` itself or the selected
+/// sub-command (nested ones included, e.g. `synth planar`) got `--config FILE`, parses again with the file's flags
 /// in front of the user's own so that flags given on the command line win, and required flags
 /// may come from the file; that needs options that keep the last value given
 /// (`app->option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast)` before the

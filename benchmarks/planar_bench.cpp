@@ -4,18 +4,21 @@
 // (logos, indoor, outdoor), are each laid on a plane and viewed from an orbit above it
 // (sim/planar_scene.h: homography rendering, per-pixel Gaussian intensity noise of P % of 255,
 // initial poses perturbed by --init-translation / --init-rotation-deg). Every photo x noise
-// P in {0, 5, 10, 15, 20} runs the whole incremental pipeline (frontend/pipeline.h, default
-// options, one thread) and its global BA, sequentially. The refined and the initial keyframe
-// trajectories are compared with the true poses of the same keyframes after a Sim(3) Umeyama
-// alignment (ATE = RMS camera-centre error, mm).
+// P in {0, 5, 10, 15, 20} runs the whole incremental pipeline (frontend/pipeline.h, one thread)
+// and its global BA. Every pipeline option is a flag named as in `curvesfm run` (`--ba-*`,
+// `--local-ba-*`, ...; `--config FILE.yaml` takes run's config.yaml), so variants compare with one
+// command; `--photos` and `--noise` pick a subset of the cases. The refined and the initial
+// keyframe trajectories are compared with the true poses of the same keyframes after a Sim(3)
+// Umeyama alignment (ATE = RMS camera-centre error, mm).
 //
 // A photo that is missing or unreadable is skipped with a message on stdout and stderr; no
 // photo at all is an error (exit 1). A case whose pipeline throws is recorded as failed (its
 // message in the table and CSV) and counts as not improved.
 //
 // Writes into --out: runs.csv (one row per case, per-stage timings included), summary.md (the
-// table, the paper's Table 2 beside ours, stage timings), ate_ratio_vs_noise.png and
-// ate_vs_noise.png. Prints the table and `key: value` headline lines; progress on stderr.
+// table, the paper's Table 2 beside ours, stage timings), config.yaml (every flag in force, for
+// --config), ate_ratio_vs_noise.png and ate_vs_noise.png. Prints the table and `key: value`
+// headline lines; progress on stderr.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
@@ -35,6 +38,9 @@
 #include <utility>
 #include <vector>
 
+#include "apps/cli_options.h"
+#include "apps/config_file.h"
+#include "apps/pipeline_flags.h"
 #include "benchmarks/support/bench_common.h"
 #include "core/errors.h"
 #include "core/plot.h"
@@ -75,7 +81,10 @@ struct BenchOptions {
   InitNoiseModel init_noise_model = PlanarSceneOptions().init_noise_model;
   double init_translation_m = PlanarSceneOptions().init_noise_translation;  ///< Per axis (m).
   double init_rotation_deg = PlanarSceneOptions().init_noise_rotation_deg;  ///< Per axis (deg).
-  bool quick = false;  ///< 2 photos x 2 noise levels x 10 frames.
+  bool quick = false;               ///< 2 photos x 2 noise levels x 10 frames.
+  std::vector<std::string> photos;  ///< File names of kPhotos to run; empty runs all.
+  std::vector<int> noise_percents = kNoisePercents;  ///< Intensity noise levels to run (%).
+  PipelineOptions pipeline;                          ///< Every case's pipeline.
   /// Cases run at once, one thread each (each case is single-threaded); per-stage times are
   /// wall times, so more jobs than idle cores inflate them.
   int jobs = 1;
@@ -111,7 +120,8 @@ struct CaseResult {
 std::vector<LoadedPhoto> loadPhotos(const BenchOptions& options) {
   std::vector<LoadedPhoto> loaded;
   for (std::size_t i = 0; i < kPhotos.size(); ++i) {
-    if (options.quick && kPhotos[i].file != "LinuxLogo.jpg" && kPhotos[i].file != "building.jpg")
+    if (!options.photos.empty() && std::find(options.photos.begin(), options.photos.end(),
+                                             kPhotos[i].file) == options.photos.end())
       continue;
     const std::string path = options.data_dir + "/" + kPhotos[i].file;
     const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
@@ -127,8 +137,8 @@ std::vector<LoadedPhoto> loadPhotos(const BenchOptions& options) {
 }
 
 // Runs the pipeline over the scene; fills keyframe counts, ATEs and timings of `result`.
-void runPipeline(const PlanarScene& scene, CaseResult* result) {
-  Pipeline pipeline(*scene.camera, PipelineOptions{});
+void runPipeline(const PlanarScene& scene, const PipelineOptions& options, CaseResult* result) {
+  Pipeline pipeline(*scene.camera, options);
   std::vector<KeyframeStats> keyframes;
   for (std::size_t i = 0; i < scene.images.size(); ++i) {
     const KeyframeStats stats =
@@ -168,7 +178,7 @@ CaseResult runCase(const LoadedPhoto& photo, int noise_percent, const BenchOptio
   scene_options.init_noise_rotation_deg = options.init_rotation_deg;
   const auto start = bench::Clock::now();
   try {
-    runPipeline(makePlanarScene(photo.image, scene_options), &result);
+    runPipeline(makePlanarScene(photo.image, scene_options), options.pipeline, &result);
   } catch (const std::exception& e) {
     result.error = e.what();
   }
@@ -302,7 +312,8 @@ void writeSummary(const std::vector<CaseResult>& results, const BenchOptions& op
       << (options.init_noise_model == InitNoiseModel::kDrift
               ? "per step between frames (drift: the errors accumulate as a visual odometry's)"
               : "per pose (independent errors)")
-      << ". The pipeline runs with default options on one thread. ATE: RMS "
+      << ". The pipeline runs on one thread with the options in config.yaml beside this file. "
+         "ATE: RMS "
          "camera-centre error of the keyframes after a Sim(3) Umeyama alignment to their true "
          "poses.\n\n## Every case\n\n"
       << casesTable(results)
@@ -420,19 +431,24 @@ void printStageMedians(const std::vector<CaseResult>& results) {
   }
 }
 
+void writeText(const std::string& text, const std::filesystem::path& path) {
+  std::ofstream out(path);
+  if (!(out << text)) throw IoError(path.string(), "cannot write");
+}
+
 std::string commandLine(int argc, char** argv) {
   std::string command;
   for (int i = 0; i < argc; ++i) command += (i == 0 ? "" : " ") + std::string(argv[i]);
   return command;
 }
 
-int run(const BenchOptions& options, const std::string& command) {
+int run(const BenchOptions& options, const std::string& command, const std::string& config_yaml) {
   cv::setNumThreads(1);
   const auto start = bench::Clock::now();
   const std::filesystem::path out(options.out);
   std::filesystem::create_directories(out);
   const std::vector<LoadedPhoto> photos = loadPhotos(options);
-  const std::vector<int> noises = options.quick ? std::vector<int>{0, 10} : kNoisePercents;
+  const std::vector<int>& noises = options.noise_percents;
   std::printf("# planar_bench: %zu photos x %zu noise levels, %d frames each\n", photos.size(),
               noises.size(), options.frames);
   for (const LoadedPhoto& p : photos)
@@ -460,13 +476,16 @@ int run(const BenchOptions& options, const std::string& command) {
 
   writeCsv(results, out / "runs.csv");
   writeSummary(results, options, command, out / "summary.md");
+  writeText("# planar_bench: the options in force; rerun with --config " +
+                (out / "config.yaml").string() + "\n" + config_yaml,
+            out / "config.yaml");
   plotRatio(results, out / "ate_ratio_vs_noise.png");
   plotAgainstPaper(results, out / "ate_vs_noise.png");
   std::printf("\n%s\n%s\n", casesTable(results).c_str(), table2Comparison(results).c_str());
   printHeadlines(results);
   printStageMedians(results);
   bench::print("total_seconds", bench::secondsSince(start));
-  bench::printText("outputs", (out / "{runs.csv,summary.md,*.png}").string());
+  bench::printText("outputs", (out / "{runs.csv,summary.md,config.yaml,*.png}").string());
   return 0;
 }
 
@@ -476,6 +495,9 @@ int run(const BenchOptions& options, const std::string& command) {
 int main(int argc, char** argv) {
   curvesfm::BenchOptions options;
   CLI::App app{"The paper's planar experiment: 9 photos x 5 noise levels through the pipeline"};
+  app.name("planar_bench");  // For the usage line: parsing a vector does not read argv[0].
+  // A flag given in the config file and again on the command line: the last one wins.
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   app.add_option("--data-dir", options.data_dir, "Folder of OpenCV's sample photos")
       ->capture_default_str();
   app.add_option("--out", options.out, "Output folder for CSV, table and plots")
@@ -499,14 +521,34 @@ int main(int argc, char** argv) {
                  "Std dev per axis of the initial rotation error (deg), per step or per pose")
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
-  app.add_flag("--quick", options.quick, "2 photos x 2 noise levels x 10 frames (smoke test)");
+  std::vector<std::string> photo_names;
+  for (const curvesfm::Photo& photo : curvesfm::kPhotos) photo_names.push_back(photo.file);
+  app.add_option("--photos", options.photos, "Only these photos (file names); default all")
+      ->check(CLI::IsMember(photo_names))
+      ->delimiter(',');
+  app.add_option("--noise", options.noise_percents, "Intensity noise levels to run (%)")
+      ->check(CLI::Range(0, 100))
+      ->delimiter(',')
+      ->capture_default_str();
+  app.add_flag("--quick", options.quick,
+               "LinuxLogo and building x noise 0, 10 % x 10 frames (smoke test)");
   app.add_option("--jobs", options.jobs,
                  "Cases run at once (one thread each; stage times are wall times)")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
+  curvesfm::addConfigFlag(&app);
+  curvesfm::addPipelineFlags(&app, &options.pipeline);
   const std::string command = curvesfm::commandLine(argc, argv);
-  return curvesfm::bench::parseAndRun(app, argc, argv, [&] {
-    if (options.quick) options.frames = std::min(options.frames, 10);
-    return curvesfm::run(options, command);
+  const auto parse = [&] {
+    curvesfm::parseCommandLine(&app, std::vector<std::string>(argv + 1, argv + argc));
+  };
+  return curvesfm::bench::parseWithAndRun(app, parse, [&] {
+    if (options.quick) {
+      options.photos = {"LinuxLogo.jpg", "building.jpg"};
+      options.noise_percents = {0, 10};
+      options.frames = std::min(options.frames, 10);
+    }
+    options.pipeline.validate();
+    return curvesfm::run(options, command, curvesfm::effectiveOptionsYaml(app));
   });
 }

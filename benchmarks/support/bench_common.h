@@ -10,6 +10,7 @@
 #include <exception>
 #include <iostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/errors.h"
@@ -43,14 +44,18 @@ inline void printText(const std::string& key, const std::string& value) {
   std::printf("%s: %s\n", key.c_str(), value.c_str());
 }
 
-/// Parses the command line of `app`, then runs `run`. Exit codes as the curvesfm binary: 2 for
-/// usage errors and invalid options, 1 for any other error (one line on stderr), else run's.
-template <class Run>
-int parseAndRun(CLI::App& app, int argc, char** argv, Run&& run) {
+/// Runs `parse` (which fills `app`), then `run`. Exit codes as the curvesfm binary: 2 for usage
+/// errors (CLI::ParseError, or a curvesfm::Error while parsing, e.g. a bad --config file) and
+/// invalid options, 1 for any other error (one line on stderr), else run's.
+template <class Parse, class Run>
+int parseWithAndRun(CLI::App& app, Parse&& parse, Run&& run) {
   try {
-    app.parse(argc, argv);
+    parse();
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
+  } catch (const Error& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
   }
   try {
     return run();
@@ -61,6 +66,13 @@ int parseAndRun(CLI::App& app, int argc, char** argv, Run&& run) {
     std::cerr << "error: " << e.what() << "\n";
     return 1;
   }
+}
+
+/// parseWithAndRun with CLI11's own parse of argv.
+template <class Run>
+int parseAndRun(CLI::App& app, int argc, char** argv, Run&& run) {
+  return parseWithAndRun(
+      app, [&] { app.parse(argc, argv); }, std::forward<Run>(run));
 }
 
 }  // namespace curvesfm::bench

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "apps/cli_options.h"
 #include "core/errors.h"
 
 namespace curvesfm {
@@ -47,8 +48,8 @@ class ConfigFileTest : public ::testing::Test {
 TEST_F(ConfigFileTest, TurnsKeysIntoFlags) {
   const auto args =
       configFileArguments(write("max-iterations: 7\nkernel: cauchy\nverbose: true\n"), *command_);
-  EXPECT_EQ(args, (std::vector<std::string>{"--max-iterations", "7", "--kernel", "cauchy",
-                                            "--verbose"}));
+  EXPECT_EQ(args,
+            (std::vector<std::string>{"--max-iterations", "7", "--kernel", "cauchy", "--verbose"}));
   EXPECT_TRUE(configFileArguments(write("verbose: false\n"), *command_).empty());
   EXPECT_TRUE(configFileArguments(write(""), *command_).empty());
 }
@@ -67,8 +68,7 @@ TEST_F(ConfigFileTest, MalformedYamlNamesFileAndLine) {
 
 TEST_F(ConfigFileTest, BadFlagValueAndNestingAreRejected) {
   EXPECT_NE(messageOf(write("verbose: maybe\n")).find("config.yaml:1:"), std::string::npos);
-  EXPECT_NE(messageOf(write("kernel:\n  type: huber\n")).find("nested mapping"),
-            std::string::npos);
+  EXPECT_NE(messageOf(write("kernel:\n  type: huber\n")).find("nested mapping"), std::string::npos);
 }
 
 TEST_F(ConfigFileTest, MissingFileIsAnIoError) {
@@ -92,6 +92,21 @@ TEST_F(ConfigFileTest, EffectiveOptionsGiveTheValueInForce) {
   EXPECT_EQ(iterations_, 9);
   const std::string yaml = effectiveOptionsYaml(*command_);
   EXPECT_NE(yaml.find("max-iterations: 9\n"), std::string::npos) << yaml;
+}
+
+TEST_F(ConfigFileTest, AProgramWithoutSubcommandsReadsItsOwnConfigFlag) {
+  // As planar_bench: the flags, --config among them, belong to the program itself.
+  CLI::App program;
+  program.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  int iterations = 0;
+  std::string kernel;
+  program.add_option("--max-iterations", iterations);
+  program.add_option("--kernel", kernel);
+  addConfigFlag(&program);
+  const std::string path = write("max-iterations: 7\nkernel: cauchy\n");
+  parseCommandLine(&program, {"--config", path, "--kernel", "huber"});
+  EXPECT_EQ(iterations, 7);
+  EXPECT_EQ(kernel, "huber");  // The command line wins over the file.
 }
 
 }  // namespace

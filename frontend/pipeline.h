@@ -60,10 +60,10 @@ struct PipelineOptions {
   /// the global curves (curves constant; temporary ones were never refined), so that
   /// registration can succeed when the initial pose puts projections farther than
   /// correspondence.max_mean_edge_distance_px off. A starting value only. Off by default: on the
-  /// planar orbit it makes the trajectory worse (30 frames, drifting start, no re-association:
-  /// ATE 2.0 -> 5.8 mm against 1.45 mm untracked), since the incremental map, lifted over short
-  /// baselines with the given poses, is off by centimetres in depth until re-association and
-  /// global BA fix it.
+  /// planar orbit it made the trajectory worse (30 frames, drifting start, no re-association,
+  /// before the motion prior and curves-only local BA: ATE 2.0 -> 5.8 mm against 1.45 mm
+  /// untracked), since the incremental map, lifted over short baselines with the given poses, is
+  /// off by centimetres in depth until re-association and global BA fix it.
   bool track_keyframe_pose = false;
   /// Solver of that pose refinement (max_iterations per keyframe).
   OptimizerOptions tracking;

@@ -117,6 +117,12 @@ struct CaseResult {
   double ratio() const { return refined_ate_mm / initial_ate_mm; }
 };
 
+std::string photoNames() {
+  std::string names;
+  for (const Photo& photo : kPhotos) names += (names.empty() ? "" : ", ") + photo.file;
+  return names;
+}
+
 std::vector<LoadedPhoto> loadPhotos(const BenchOptions& options) {
   std::vector<LoadedPhoto> loaded;
   for (std::size_t i = 0; i < kPhotos.size(); ++i) {
@@ -431,6 +437,49 @@ void printStageMedians(const std::vector<CaseResult>& results) {
   }
 }
 
+std::vector<std::string> splitAtCommas(const std::string& list, const std::string& flag) {
+  std::vector<std::string> items;
+  std::stringstream stream(list);
+  for (std::string item; std::getline(stream, item, ',');) {
+    if (item.empty()) throw CLI::ValidationError(flag, "empty item in '" + list + "'");
+    items.push_back(item);
+  }
+  if (items.empty()) throw CLI::ValidationError(flag, "no item given");
+  return items;
+}
+
+// "all" or photo file names of kPhotos; throws CLI::ValidationError naming the flag.
+std::vector<std::string> parsePhotoList(const std::string& list) {
+  if (list == "all") return {};
+  std::vector<std::string> photos = splitAtCommas(list, "--photos");
+  for (const std::string& photo : photos) {
+    const auto known = [&](const Photo& p) { return p.file == photo; };
+    if (std::none_of(kPhotos.begin(), kPhotos.end(), known)) {
+      throw CLI::ValidationError("--photos",
+                                 "'" + photo + "' is not a benchmark photo (" + photoNames() + ")");
+    }
+  }
+  return photos;
+}
+
+// Noise levels in [0, 100] %; throws CLI::ValidationError naming the flag.
+std::vector<int> parseNoiseList(const std::string& list) {
+  std::vector<int> levels;
+  for (const std::string& item : splitAtCommas(list, "--noise")) {
+    std::size_t used = 0;
+    int level = -1;
+    try {
+      level = std::stoi(item, &used);
+    } catch (const std::exception&) {
+    }
+    if (used != item.size() || level < 0 || level > 100) {
+      throw CLI::ValidationError("--noise", "'" + item + "' is not a percentage in [0, 100]");
+    }
+    levels.push_back(level);
+  }
+  return levels;
+}
+
 void writeText(const std::string& text, const std::filesystem::path& path) {
   std::ofstream out(path);
   if (!(out << text)) throw IoError(path.string(), "cannot write");
@@ -521,15 +570,20 @@ int main(int argc, char** argv) {
                  "Std dev per axis of the initial rotation error (deg), per step or per pose")
       ->check(CLI::Range(0.0, 45.0))
       ->capture_default_str();
-  std::vector<std::string> photo_names;
-  for (const curvesfm::Photo& photo : curvesfm::kPhotos) photo_names.push_back(photo.file);
-  app.add_option("--photos", options.photos, "Only these photos (file names); default all")
-      ->check(CLI::IsMember(photo_names))
-      ->delimiter(',');
-  app.add_option("--noise", options.noise_percents, "Intensity noise levels to run (%)")
-      ->check(CLI::Range(0, 100))
-      ->delimiter(',')
-      ->capture_default_str();
+  // Lists are one comma-separated value, so that the last flag wins over --config as for every
+  // other flag, and config.yaml echoes them as one scalar.
+  app.add_option_function<std::string>(
+         "--photos",
+         [&options](const std::string& list) { options.photos = curvesfm::parsePhotoList(list); },
+         "Comma-separated photo file names to run, or all")
+      ->default_str("all");
+  app.add_option_function<std::string>(
+         "--noise",
+         [&options](const std::string& list) {
+           options.noise_percents = curvesfm::parseNoiseList(list);
+         },
+         "Comma-separated intensity noise levels to run (%)")
+      ->default_str("0,5,10,15,20");
   app.add_flag("--quick", options.quick,
                "LinuxLogo and building x noise 0, 10 % x 10 frames (smoke test)");
   app.add_option("--jobs", options.jobs,

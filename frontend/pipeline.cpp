@@ -520,14 +520,14 @@ PipelineResult Pipeline::finish() {
   impl.finished = true;
   PipelineResult result;
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
-    result.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba, true,
-                                         &result.final_samples);
+    result.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
+                                         /*refine_poses=*/true, &result.final_samples);
     for (int r = 0; r < impl.options.reassociation_rounds; ++r) {
       ReassociationRound round;
       round.added_observations = impl.reassociate();
       if (round.added_observations == 0) break;
-      round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba, true,
-                                          &result.final_samples);
+      round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
+                                          /*refine_poses=*/true, &result.final_samples);
       result.reassociation.push_back(std::move(round));
     }
   }

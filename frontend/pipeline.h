@@ -42,7 +42,8 @@ struct PipelineOptions {
   /// default: on a start that drifts like odometry (locally accurate, globally off) the young
   /// curves, lifted over short baselines, are too far off to correct the poses, and local BA
   /// moving them makes the trajectory worse in every failing case of the planar bench (e.g.
-  /// LinuxLogo 0 %: 3.24 -> 6.91 mm moving poses, 2.45 mm holding them; docs/benchmarks.md).
+  /// LinuxLogo 0 % with a 0.1 deg / 2 mm motion prior: 3.24 -> 6.91 mm moving poses, 2.45 mm
+  /// holding them; docs/benchmarks.md).
   bool local_ba_refines_poses = false;
   SchedulerOptions global_ba;  ///< Once at the end (global scope).
   bool run_global_ba = true;   ///< Run global BA in finish().

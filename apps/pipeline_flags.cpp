@@ -258,11 +258,28 @@ OptionFields schedulerFields(const std::string& group, const std::string& prefix
   return fields;
 }
 
+OptionFields extensionFields(CurveExtensionOptions* o) {
+  const std::string g = "extension";
+  return {
+      boolean(g, "enabled", "extend-curves", &o->enabled,
+              "Append a new curve that continues an existing curve's end to that curve"),
+      number(g, "max_gap_px", "extend-max-gap", &o->max_gap_px,
+             "Largest gap between the projected end points (px)"),
+      number(g, "max_lateral_px", "extend-max-lateral", &o->max_lateral_px,
+             "Largest offset across the existing end's image tangent, and overlap behind it (px)"),
+      number(g, "max_angle_deg", "extend-max-angle", &o->max_angle_deg,
+             "Largest angle between the two curves' image directions at the join (deg)"),
+      number(g, "max_relative_depth_gap", "extend-max-depth-gap", &o->max_relative_depth_gap,
+             "Largest 3D gap between the end points, as a fraction of the existing end's depth"),
+  };
+}
+
 OptionFields pipelineFields(PipelineOptions* o) {
   const std::string g = "pipeline";
   OptionFields fields = imageFields(o);
   append(&fields, depthFields(&o->depth));
   append(&fields, initialiserFields(&o->initialiser));
+  append(&fields, extensionFields(&o->extension));
   append(&fields, matchAndMapFields(&o->correspondence, &o->map));
   append(&fields, objectiveFields(&o->ba));
   append(&fields, schedulerFields("local_ba", "local-ba-", "local BA", &o->local_ba));

@@ -146,12 +146,12 @@ double secondsSince(Clock::time_point start) {
 void printProgress(const KeyframeStats& s, int frames) {
   std::printf(
       "frame %d/%d keyframe %d: curves %d global / %d temporary, registered %d (rejected %d: "
-      "%d duplicate, %d edge distance, %d appearance, %d other), new %d, frontend %.0f ms, "
-      "local BA %.0f ms\n",
+      "%d duplicate, %d edge distance, %d appearance, %d other), new %d, extended %d, "
+      "frontend %.0f ms, local BA %.0f ms\n",
       s.frame_index + 1, frames, s.keyframe_index, s.global_curves, s.temporary_curves,
       s.registered_segments, s.rejectedSegments(), s.rejected_duplicate, s.rejected_edge_distance,
       s.rejected_appearance, s.rejected_depth + s.rejected_viewing_direction, s.new_curves,
-      1e3 * s.frontendSeconds(), 1e3 * s.local_ba_seconds);
+      s.extended_curves, 1e3 * s.frontendSeconds(), 1e3 * s.local_ba_seconds);
   std::fflush(stdout);
 }
 
@@ -242,6 +242,7 @@ nlohmann::json frameToJson(const KeyframeStats& s) {
         {"viewing_direction", s.rejected_viewing_direction},
         {"appearance", s.rejected_appearance}}},
       {"new_curves", s.new_curves},
+      {"extended_curves", s.extended_curves},
       {"global_curves", s.global_curves},
       {"temporary_curves", s.temporary_curves},
       {"local_ba_cost", {{"initial", s.local_ba_initial_cost}, {"final", s.local_ba_final_cost}}}};
@@ -309,9 +310,12 @@ void printFrontendStages(const std::vector<KeyframeStats>& frames) {
 
 void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
   double frontend = 0.0, local_ba = 0.0;
+  int started = 0, extended = 0;
   for (const KeyframeStats& s : r.frames) {
     frontend += s.frontendSeconds();
     local_ba += s.local_ba_seconds;
+    started += s.new_curves;
+    extended += s.extended_curves;
   }
   const CurveSampleCounts& samples = r.final_samples;
   std::printf(
@@ -319,6 +323,8 @@ void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
       "%zu curves (%d segments) in the global map\n",
       d.frames.size(), d.images - static_cast<int>(d.frames.size()), d.images,
       r.keyframe_cam_from_world.size(), r.curves.size(), totalSegments(r.curves));
+  std::printf("map: %d curves started, %d new curves appended to an existing curve's end\n",
+              started, extended);
   if (!r.global_ba.rounds.empty()) {
     std::printf("global BA: cost %.6g -> %.6g, %d iterations, %.2f s (%s)\n",
                 r.global_ba.initial_cost, r.global_ba.final_cost, r.global_ba.total_iterations,

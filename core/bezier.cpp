@@ -157,4 +157,40 @@ int totalSegments(const std::vector<PolyBezier>& curves) {
   return segments;
 }
 
+const Eigen::Vector3d& endPoint(const PolyBezier& curve, CurveEnd end) {
+  return end == CurveEnd::kFront ? curve.points().front() : curve.points().back();
+}
+
+Eigen::Vector3d outwardTangent(const PolyBezier& curve, CurveEnd end) {
+  return end == CurveEnd::kFront ? Eigen::Vector3d(-curve.directions().front().vector())
+                                 : curve.directions().back().vector();
+}
+
+int endSegment(const PolyBezier& curve, CurveEnd end) {
+  return end == CurveEnd::kFront ? 0 : curve.numSegments() - 1;
+}
+
+PolyBezier reversed(const PolyBezier& curve) {
+  std::vector<Eigen::Vector3d> points(curve.points().rbegin(), curve.points().rend());
+  std::vector<Direction> directions;
+  for (auto it = curve.directions().rbegin(); it != curve.directions().rend(); ++it) {
+    directions.emplace_back(-it->vector());
+  }
+  std::vector<SegmentLengths> lengths;
+  for (auto it = curve.lengths().rbegin(); it != curve.lengths().rend(); ++it) {
+    lengths.push_back({it->d2, it->d1});
+  }
+  return PolyBezier(std::move(points), std::move(directions), std::move(lengths));
+}
+
+PolyBezier concatenate(const PolyBezier& head, const PolyBezier& tail) {
+  std::vector<Eigen::Vector3d> points = head.points();
+  points.insert(points.end(), tail.points().begin() + 1, tail.points().end());
+  std::vector<Direction> directions = head.directions();
+  directions.insert(directions.end(), tail.directions().begin() + 1, tail.directions().end());
+  std::vector<SegmentLengths> lengths = head.lengths();
+  lengths.insert(lengths.end(), tail.lengths().begin(), tail.lengths().end());
+  return PolyBezier(std::move(points), std::move(directions), std::move(lengths));
+}
+
 }  // namespace curvesfm

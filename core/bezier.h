@@ -191,4 +191,27 @@ class PolyBezier {
 /// The number of segments of all `curves` together.
 int totalSegments(const std::vector<PolyBezier>& curves);
 
+/// One of the two ends of a poly-Bézier.
+enum class CurveEnd {
+  kFront,  ///< Q_0, where segment 0 starts.
+  kBack,   ///< Q_n, where segment n-1 ends.
+};
+
+/// The point at `end`: Q_0 or Q_n.
+const Eigen::Vector3d& endPoint(const PolyBezier& curve, CurveEnd end);
+/// The unit tangent at `end` pointing away from the curve: -v_0 at the front, v_n at the back.
+Eigen::Vector3d outwardTangent(const PolyBezier& curve, CurveEnd end);
+/// The segment that touches `end`: 0 or n-1.
+int endSegment(const PolyBezier& curve, CurveEnd end);
+
+/// The same curve traversed the other way: Q_n..Q_0, tangents negated, and each segment's arm
+/// lengths swapped. Point for point, segment n-1-i at 1 - t equals segment i at t.
+PolyBezier reversed(const PolyBezier& curve);
+
+/// The curve that runs along `head`, then along `tail`: head's segments, then tail's. The join
+/// is head's last point and tangent; tail's first point and tangent are dropped, so tail's
+/// first segment starts at head's end with its own arm lengths (exactly tail's segment when
+/// they already coincide).
+PolyBezier concatenate(const PolyBezier& head, const PolyBezier& tail);
+
 }  // namespace curvesfm

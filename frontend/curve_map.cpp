@@ -151,6 +151,21 @@ void CurveMap::addObservation(int id, int segment, const ObservedSegmentAppearan
   s.viewing.add(observation.viewing_direction_in_world);
 }
 
+void CurveMap::extendCurve(int id, const PolyBezier& extended, CurveEnd end) {
+  curve(id);
+  MapCurve& c = curves_[id];
+  const int added = extended.numSegments() - c.curve.numSegments();
+  CURVESFM_CHECK(added > 0) << "extending curve " << id << " of " << c.curve.numSegments()
+                            << " segments to " << extended.numSegments() << " segments";
+  const auto at = end == CurveEnd::kFront ? c.segments.begin() : c.segments.end();
+  c.segments.insert(at, added, MapSegment());
+  c.curve = extended;
+  if (end == CurveEnd::kBack) return;
+  for (int i = added; i < c.curve.numSegments(); ++i) {
+    for (ObservedSegmentAppearance& o : c.segments[i].observations) o.observation.segment = i;
+  }
+}
+
 bool CurveMap::mostlyUnseen(const MapCurve& curve, int keyframe) const {
   const int first =
       std::max(curve.first_keyframe, keyframe - options_.disable_window_keyframes + 1);

@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "core/check.h"
 #include "core/errors.h"
@@ -161,6 +163,7 @@ void PipelineOptions::validate() const {
   field.validate();
   depth.validate();
   initialiser.validate();
+  extension.validate();
   correspondence.validate();
   map.validate();
   ba.validate();
@@ -193,8 +196,13 @@ struct Pipeline::Impl {
   int reassociate();
   std::vector<int> depthReferences(int k, const std::vector<EdgeChain>& chains) const;
   void initialiseCurves(int k, const std::vector<EdgeChain>& chains, KeyframeStats* stats);
-  void addNewCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
-                   const std::vector<int>& reference_keyframes);
+  std::vector<OpenEnd> openEnds(int k) const;
+  void addInitialCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
+                       const std::vector<int>& reference_keyframes, std::vector<OpenEnd>* open_ends,
+                       KeyframeStats* stats);
+  void registerNewSegments(int k, int id, const std::vector<int>& segment_ids,
+                           const InitialCurve& initial, const ChainDepths& depths,
+                           const std::vector<int>& reference_keyframes);
   CurveBundleAdjustmentInput bundleInput(CurveSelection selection, std::vector<int>* ids) const;
   ScheduleReport bundleAdjust(CurveSelection selection, const SchedulerOptions& scheduler,
                               bool refine_poses, CurveSampleCounts* samples);
@@ -372,19 +380,63 @@ void Pipeline::Impl::initialiseCurves(int k, const std::vector<EdgeChain>& chain
   start = Clock::now();
   const CurveInitialisation initialisation =
       initialiser.initialise(*camera, keyframes[k].cam_from_world, chains, depths);
+  std::vector<OpenEnd> open_ends = openEnds(k);
   for (const InitialCurve& initial : initialisation.curves) {
-    addNewCurve(k, initial, depths, reference_keyframes);
+    addInitialCurve(k, initial, depths, reference_keyframes, &open_ends, stats);
   }
-  stats->new_curves = static_cast<int>(initialisation.curves.size());
   stats->initialise_seconds = secondsSince(start);
 }
 
-void Pipeline::Impl::addNewCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
-                                 const std::vector<int>& reference_keyframes) {
-  const int id = map.addCurve(initial.curve, k);
+// The ends of the curves whose end segment keyframe k registered: the edge pixels next to them
+// belong to the same chain, so a new curve lifted from there may continue the curve.
+std::vector<OpenEnd> Pipeline::Impl::openEnds(int k) const {
+  std::vector<OpenEnd> ends;
+  if (!options.extension.enabled) return ends;
+  for (int id = 0; id < map.size(); ++id) {
+    const MapCurve& c = map.curve(id);
+    for (const CurveEnd end : {CurveEnd::kFront, CurveEnd::kBack}) {
+      if (!c.segments[endSegment(c.curve, end)].observedIn(k)) continue;
+      const std::optional<OpenEnd> open =
+          openEnd(id, c.curve, end, keyframes[k].cam_from_world, *camera);
+      if (open) ends.push_back(*open);
+    }
+  }
+  return ends;
+}
+
+// Adds `initial` to the map: appended to the open end it continues smoothly (that end is then
+// used up), else as a curve of its own.
+void Pipeline::Impl::addInitialCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
+                                     const std::vector<int>& reference_keyframes,
+                                     std::vector<OpenEnd>* open_ends, KeyframeStats* stats) {
+  const std::optional<CurveJoin> join =
+      findJoin(initial.curve, *open_ends, keyframes[k].cam_from_world, *camera, options.extension);
+  if (!join) {
+    const int id = map.addCurve(initial.curve, k);
+    std::vector<int> segment_ids(initial.curve.numSegments());
+    std::iota(segment_ids.begin(), segment_ids.end(), 0);
+    registerNewSegments(k, id, segment_ids, initial, depths, reference_keyframes);
+    ++stats->new_curves;
+    return;
+  }
+  const OpenEnd open = (*open_ends)[join->open_end];
+  open_ends->erase(open_ends->begin() + join->open_end);
+  const ExtendedCurve extended =
+      extendCurve(map.curve(open.curve).curve, open.end, initial.curve, join->new_end);
+  map.extendCurve(open.curve, extended.curve, open.end);
+  registerNewSegments(k, open.curve, extended.added_segments, initial, depths, reference_keyframes);
+  ++stats->extended_curves;
+}
+
+// Registers in keyframe k, and in the reference view its depth came from, each segment i of
+// `initial`, which is segment segment_ids[i] of map curve `id`.
+void Pipeline::Impl::registerNewSegments(int k, int id, const std::vector<int>& segment_ids,
+                                         const InitialCurve& initial, const ChainDepths& depths,
+                                         const std::vector<int>& reference_keyframes) {
   const std::vector<PixelDepth>& chain_depths = depths.chains[initial.chain];
-  for (int i = 0; i < initial.curve.numSegments(); ++i) {
-    const BezierSegmentParams segment = initial.curve.segment(i);
+  for (std::size_t i = 0; i < segment_ids.size(); ++i) {
+    const int s = segment_ids[i];
+    const BezierSegmentParams segment = map.curve(id).curve.segment(s);
     const ObservedSegmentAppearance here =
         measureSegment(segment, k, keyframes[k], *camera, options.correspondence);
     // The reference view saw the segment too (its depth came from there); verify it as any other
@@ -398,10 +450,10 @@ void Pipeline::Impl::addNewCurve(int k, const InitialCurve& initial, const Chain
       const CorrespondenceVerdict verdict =
           registerSegment(segment, viewOf(keyframes[j], *camera), history, options.correspondence);
       if (verdict.registered) {
-        map.addObservation(id, i, registration(id, i, j, verdict));
+        map.addObservation(id, s, registration(id, s, j, verdict));
       }
     }
-    map.addObservation(id, i, here);
+    map.addObservation(id, s, here);
   }
 }
 

@@ -11,6 +11,7 @@
 #include "core/pose3.h"
 #include "frontend/correspondence_checks.h"
 #include "frontend/curve_bundle_adjustment.h"
+#include "frontend/curve_extension.h"
 #include "frontend/curve_initialiser.h"
 #include "frontend/curve_map.h"
 #include "frontend/edge_chains.h"
@@ -32,6 +33,8 @@ struct PipelineOptions {
   NearestEdgeFieldOptions field;
   EpipolarDepthOptions depth;
   CurveInitialiserOptions initialiser;
+  /// When a new curve continues an existing one instead of starting on its own.
+  CurveExtensionOptions extension;
   CorrespondenceOptions correspondence;
   CurveMapOptions map;              ///< Promotion, disabling, keyframe selection.
   CurveBundleAdjustmentOptions ba;  ///< The objective of local and global BA.
@@ -109,8 +112,9 @@ struct KeyframeStats {
   int rejected_edge_distance = 0;
   int rejected_viewing_direction = 0;
   int rejected_appearance = 0;
-  int new_curves = 0;
-  int global_curves = 0;  ///< Curves in the global map after this keyframe.
+  int new_curves = 0;       ///< Curves started from unregistered edges.
+  int extended_curves = 0;  ///< New curves appended to an existing curve's end instead.
+  int global_curves = 0;    ///< Curves in the global map after this keyframe.
   int temporary_curves = 0;
   double local_ba_initial_cost = 0.0;
   double local_ba_final_cost = 0.0;

@@ -324,5 +324,58 @@ TEST(PolyBezier, SampleHasOnePointPerStepAndNoDuplicates) {
   EXPECT_THROW(curve.sample(0), CheckError);
 }
 
+TEST(PolyBezier, EndsGiveTheirPointOutwardTangentAndSegment) {
+  const PolyBezier curve = makeZigZagCurve();
+  EXPECT_EQ(endPoint(curve, CurveEnd::kFront), curve.points()[0]);
+  EXPECT_EQ(endPoint(curve, CurveEnd::kBack), curve.points()[3]);
+  EXPECT_EQ(endSegment(curve, CurveEnd::kFront), 0);
+  EXPECT_EQ(endSegment(curve, CurveEnd::kBack), 2);
+  // Outward: a step along it leaves the curve, i.e. opposes the direction of travel into it.
+  EXPECT_LT(outwardTangent(curve, CurveEnd::kFront).dot(curve.derivative(0, 0.0)), 0.0);
+  EXPECT_GT(outwardTangent(curve, CurveEnd::kBack).dot(curve.derivative(2, 1.0)), 0.0);
+  EXPECT_NEAR(outwardTangent(curve, CurveEnd::kFront).norm(), 1.0, 1e-15);
+}
+
+TEST(PolyBezier, ReversedTracesTheSamePointsBackwards) {
+  const PolyBezier curve = makeZigZagCurve();
+  const PolyBezier back = reversed(curve);
+  ASSERT_EQ(back.numSegments(), curve.numSegments());
+  const int n = curve.numSegments();
+  for (int i = 0; i < n; ++i) {
+    for (const double t : {0.0, 0.2, 0.5, 0.9, 1.0}) {
+      EXPECT_LT((back.evaluate(n - 1 - i, 1.0 - t) - curve.evaluate(i, t)).norm(), 1e-14)
+          << "segment " << i << " t " << t;
+    }
+  }
+  const PolyBezier twice = reversed(back);
+  EXPECT_EQ(twice.points(), curve.points());
+  for (int i = 0; i < n; ++i) EXPECT_EQ(twice.lengths()[i].d1, curve.lengths()[i].d1);
+}
+
+TEST(PolyBezier, ConcatenateKeepsHeadAndTailSegmentsAndTheHeadsJoin) {
+  const PolyBezier curve = makeZigZagCurve();
+  // Split at Q_1: head = segment 0, tail = segments 1-2; joining them gives the curve back.
+  const PolyBezier head({curve.points()[0], curve.points()[1]},
+                        {curve.directions()[0], curve.directions()[1]}, {curve.lengths()[0]});
+  const PolyBezier tail({curve.points()[1], curve.points()[2], curve.points()[3]},
+                        {curve.directions()[1], curve.directions()[2], curve.directions()[3]},
+                        {curve.lengths()[1], curve.lengths()[2]});
+  const PolyBezier joined = concatenate(head, tail);
+  ASSERT_EQ(joined.numSegments(), 3);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(joined.evaluate(i, 0.3), curve.evaluate(i, 0.3));
+  }
+  // A tail that starts elsewhere is pulled onto head's end with head's tangent; its own
+  // points and arm lengths stay.
+  PolyBezier moved = tail;
+  moved.setPoint(0, tail.points()[0] + Eigen::Vector3d(0.1, 0.2, 0.0));
+  moved.setDirection(0, Direction(Eigen::Vector3d::UnitZ()));
+  const PolyBezier pulled = concatenate(head, moved);
+  EXPECT_EQ(pulled.points()[1], head.points()[1]);
+  EXPECT_EQ(pulled.directions()[1].vector(), head.directions()[1].vector());
+  EXPECT_EQ(pulled.points()[3], tail.points()[2]);
+  EXPECT_EQ(pulled.lengths()[1].d1, tail.lengths()[0].d1);
+}
+
 }  // namespace
 }  // namespace curvesfm

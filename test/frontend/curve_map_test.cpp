@@ -148,6 +148,42 @@ TEST(CurveMap, ExportsObservationsAndTakesUpdates) {
   EXPECT_THROW(map.updateCurves(ids, {straightCurve(2)}), CheckError);
 }
 
+TEST(CurveMap, ExtendingAtTheBackAppendsUnobservedSegments) {
+  CurveMap map;
+  const int id = map.addCurve(straightCurve(2), 0);
+  observeSegments(&map, id, 0, 1, 0);
+  map.extendCurve(id, straightCurve(5), CurveEnd::kBack);
+  const MapCurve& c = map.curve(id);
+  ASSERT_EQ(c.segments.size(), 5u);
+  EXPECT_TRUE(c.segments[1].observedIn(0));
+  EXPECT_TRUE(c.segments[2].observations.empty());
+  EXPECT_EQ(c.state, CurveState::kTemporary);
+  EXPECT_THROW(map.extendCurve(id, straightCurve(5), CurveEnd::kBack), CheckError);
+  EXPECT_THROW(map.extendCurve(7, straightCurve(6), CurveEnd::kBack), CheckError);
+}
+
+TEST(CurveMap, ExtendingAtTheFrontMovesObservationsWithTheirSegments) {
+  CurveMap map;
+  const int id = map.addCurve(straightCurve(2), 0);
+  map.addObservation(id, 0, seenIn(0));
+  map.addObservation(id, 1, seenIn(1));
+  map.extendCurve(id, straightCurve(5), CurveEnd::kFront);
+  const MapCurve& c = map.curve(id);
+  ASSERT_EQ(c.segments.size(), 5u);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(c.segments[i].observations.empty()) << i;
+  EXPECT_TRUE(c.segments[3].observedIn(0));
+  EXPECT_TRUE(c.segments[4].observedIn(1));
+  CurveBundleAdjustmentInput input;
+  map.addObservation(id, 0, seenIn(1));
+  map.addObservation(id, 0, seenIn(2));
+  map.endKeyframe(2);
+  map.exportCurves(CurveSelection::kGlobal, &input);
+  ASSERT_EQ(input.observations.size(), 4u);
+  EXPECT_EQ(input.observations[2].segment, 3);
+  EXPECT_EQ(input.observations[3].segment, 4);
+  EXPECT_EQ(c.segments[4].observations[0].observation.segment, 4);
+}
+
 TEST(KeyframeSelector, SelectsByTranslationOrRotation) {
   CurveMapOptions options;
   options.min_keyframe_translation = 0.01;

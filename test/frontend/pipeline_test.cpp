@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <utility>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -90,22 +91,28 @@ TEST(Pipeline, RefinesAPerturbedPlanarTrajectory) {
       << "initial ATE " << initial_ate << " m, refined " << refined_ate << " m";
 }
 
-// The largest camera-centre distance between the keyframe poses of a run without global BA and
-// the starting poses.
-double largestMoveWithoutGlobalBa(bool local_ba_refines_poses) {
+// The first five frames of the small orbit, every one a keyframe, without global BA: curves are
+// global from keyframe 2 on, so local BA runs from there.
+PipelineResult runFiveFramesWithoutGlobalBa(PipelineOptions options) {
   PlanarSceneOptions orbit = smallOrbit();
-  orbit.num_frames = 5;  // Curves are global from keyframe 2 on: local BA runs from there.
+  orbit.num_frames = 5;
   const PlanarScene scene = makePlanarScene(planarTexture(), orbit);
-  PipelineOptions options;
   options.map.min_keyframe_translation = 0.0;
   options.map.min_keyframe_rotation_deg = 0.0;
   options.run_global_ba = false;
-  options.local_ba_refines_poses = local_ba_refines_poses;
   Pipeline pipeline(*scene.camera, options);
   for (std::size_t i = 0; i < scene.images.size(); ++i) {
     pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
   }
-  const PipelineResult result = pipeline.finish();
+  return pipeline.finish();
+}
+
+// The largest camera-centre distance between the keyframe poses of that run and the starting
+// poses.
+double largestMoveWithoutGlobalBa(bool local_ba_refines_poses) {
+  PipelineOptions options;
+  options.local_ba_refines_poses = local_ba_refines_poses;
+  const PipelineResult result = runFiveFramesWithoutGlobalBa(options);
   double largest = 0.0;
   for (std::size_t j = 0; j < result.keyframe_cam_from_world.size(); ++j) {
     largest = std::max(largest, (result.keyframe_cam_from_world[j].inverseTranslation() -
@@ -118,6 +125,26 @@ double largestMoveWithoutGlobalBa(bool local_ba_refines_poses) {
 TEST(Pipeline, LocalBaMovesPosesOnlyWhenAskedTo) {
   EXPECT_EQ(largestMoveWithoutGlobalBa(false), 0.0);
   EXPECT_GT(largestMoveWithoutGlobalBa(true), 1e-5);
+}
+
+// As the orbit turns, edges run on past the ends of the curves registered in each new keyframe;
+// those pieces extend the curves instead of starting new ones, unless extension is off.
+TEST(Pipeline, ExtendsCurvesThatNewEdgesContinue) {
+  const auto count = [](bool enabled) {
+    PipelineOptions options;
+    options.extension.enabled = enabled;
+    int started = 0, extended = 0;
+    for (const KeyframeStats& s : runFiveFramesWithoutGlobalBa(options).frames) {
+      started += s.new_curves;
+      extended += s.extended_curves;
+    }
+    return std::make_pair(started, extended);
+  };
+  const auto [started_with, extended_with] = count(true);
+  const auto [started_without, extended_without] = count(false);
+  EXPECT_GT(extended_with, 0);
+  EXPECT_EQ(extended_without, 0);
+  EXPECT_LT(started_with, started_without);
 }
 
 TEST(PipelineOptions, ValidateNamesTheStageAndField) {

@@ -11,7 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
-#include "test/support/run_curvesfm.h"
+#include "test/support/run_executable.h"
 
 namespace curvesfm {
 namespace {

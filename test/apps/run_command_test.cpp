@@ -15,7 +15,7 @@
 
 #include "core/dataset_io.h"
 #include "sim/planar_scene.h"
-#include "test/support/run_curvesfm.h"
+#include "test/support/run_executable.h"
 
 namespace curvesfm {
 namespace {

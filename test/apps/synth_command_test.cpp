@@ -10,7 +10,7 @@
 #include <string>
 
 #include "core/dataset_io.h"
-#include "test/support/run_curvesfm.h"
+#include "test/support/run_executable.h"
 
 namespace curvesfm {
 namespace {

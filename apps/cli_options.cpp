@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <fstream>
-#include <initializer_list>
 #include <memory>
 
 #include "apps/config_file.h"
@@ -10,19 +9,6 @@
 
 namespace curvesfm {
 namespace {
-
-// The scene enums have no names in sim; the command line and the reports are their only readers.
-template <class Enum>
-Enum parseSceneEnum(const std::string& name, const std::string& field,
-                    std::initializer_list<Enum> all) {
-  std::string accepted;
-  for (Enum value : all) {
-    if (name == toString(value)) return value;
-    accepted += (accepted.empty() ? "" : ", ") + toString(value);
-  }
-  throw InvalidOptions("CurveSceneOptions", field, "\"" + name + "\"",
-                       "expected one of " + accepted);
-}
 
 // The selected (possibly nested) sub-command's --config file, or empty when none was given.
 std::string configPath(const CLI::App& app, const CLI::App** selected) {
@@ -129,39 +115,6 @@ void addSchedulerFlags(CLI::App* command, SchedulerOptions* options) {
                    "Alternating: stop when a round lowers the cost by less than this fraction")
       ->capture_default_str();
   addOptimizerFlags(command, &options->optimizer);
-}
-
-std::string toString(CameraPath path) {
-  switch (path) {
-    case CameraPath::kOrbit:
-      return "orbit";
-    case CameraPath::kForwardWalk:
-      return "forward_walk";
-  }
-  return "unknown";
-}
-
-std::string toString(CurveKind kind) {
-  switch (kind) {
-    case CurveKind::kLine:
-      return "line";
-    case CurveKind::kArc:
-      return "arc";
-    case CurveKind::kHelix:
-      return "helix";
-    case CurveKind::kMixed:
-      return "mixed";
-  }
-  return "unknown";
-}
-
-CameraPath parseCameraPath(const std::string& name, const std::string& field) {
-  return parseSceneEnum(name, field, {CameraPath::kOrbit, CameraPath::kForwardWalk});
-}
-
-CurveKind parseCurveKind(const std::string& name, const std::string& field) {
-  return parseSceneEnum(name, field,
-                        {CurveKind::kLine, CurveKind::kArc, CurveKind::kHelix, CurveKind::kMixed});
 }
 
 void parseCommandLine(CLI::App* app, const std::vector<std::string>& args) {

@@ -11,7 +11,6 @@
 #include "graph/optimizer.h"
 #include "graph/robust_kernel.h"
 #include "graph/scheduler.h"
-#include "sim/curve_scene.h"
 
 namespace curvesfm {
 
@@ -68,8 +67,9 @@ void addMeasurementFlags(CLI::App* command, Options* options) {
               "Hold the first camera constant (rotation and translation gauge)");
   addBoolFlag(command, "fix-scale", &options->fix_scale,
               "Hold the distance between the first two cameras at its true value (scale gauge)");
-  command->add_option("--scale-sigma", options->scale_sigma,
-                      "Std dev of that distance constraint (scene units)")
+  command
+      ->add_option("--scale-sigma", options->scale_sigma,
+                   "Std dev of that distance constraint (scene units)")
       ->capture_default_str();
 }
 
@@ -78,18 +78,10 @@ void addMeasurementFlags(CLI::App* command, Options* options) {
 /// the caller, which holds one gauge switch for the graph builder and the scheduler.
 void addSchedulerFlags(CLI::App* command, SchedulerOptions* options);
 
-/// Names of the synthetic-scene enums on the command line and in reports: "orbit",
-/// "forward_walk"; "line", "arc", "helix", "mixed". The parsers throw InvalidOptions naming
-/// CurveSceneOptions, `field` and the accepted names.
-std::string toString(CameraPath path);
-std::string toString(CurveKind kind);
-CameraPath parseCameraPath(const std::string& name, const std::string& field);
-CurveKind parseCurveKind(const std::string& name, const std::string& field);
-
 /// Parses `args` (without the program name) into `app`; if `app` itself or the selected
-/// sub-command (nested ones included, e.g. `synth planar`) got `--config FILE`, parses again with the file's flags
-/// in front of the user's own so that flags given on the command line win, and required flags
-/// may come from the file; that needs options that keep the last value given
+/// sub-command (nested ones included, e.g. `synth planar`) got `--config FILE`, parses again with
+/// the file's flags in front of the user's own so that flags given on the command line win, and
+/// required flags may come from the file; that needs options that keep the last value given
 /// (`app->option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast)` before the
 /// sub-commands are added). Throws CLI::ParseError (unknown flag, bad value) and what
 /// configFileArguments() throws (unreadable or malformed config file).

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "core/bezier.h"
@@ -38,6 +39,14 @@ enum class CurveKind {
   kHelix,  ///< Half a turn to a full turn of a helix with a 20-40 deg slope, radius >= 0.1 m.
   kMixed,  ///< Each curve picks one of the three kinds above at random (options only).
 };
+
+/// Names of the scene enums on the command line and in reports: "orbit", "forward_walk"; "line",
+/// "arc", "helix", "mixed". The parsers throw InvalidOptions naming CurveSceneOptions, `field`
+/// and the accepted names.
+std::string toString(CameraPath path);
+std::string toString(CurveKind kind);
+CameraPath parseCameraPath(const std::string& name, const std::string& field);
+CurveKind parseCurveKind(const std::string& name, const std::string& field);
 
 struct CurveSceneOptions {
   // --- cameras ---

@@ -14,9 +14,9 @@ namespace curvesfm {
 // curve if the seed group of pixels is smoothly connected to the pixels of an already existing
 // curve"). A new keyframe's unexplained edge runs begin where the projection of a registered
 // curve stops explaining the chain, a few pixels past its end; when the curve lifted from such a
-// run continues that end smoothly, in the image and in 3D, its segments are appended to the
-// existing curve instead of starting a new one, so an edge seen piece by piece as the camera
-// moves becomes one curve, with one continuous tangent, rather than a row of fragments.
+// run continues that end smoothly in the image and at the same depth, its segments are appended
+// to the existing curve instead of starting a new one, so an edge seen piece by piece as the
+// camera moves becomes one curve, with one continuous tangent, rather than a row of fragments.
 
 /// When a new curve counts as smoothly connected to an existing curve's end. Pixel tolerances
 /// are in the new keyframe; the gap is measured between the projected end points.
@@ -70,8 +70,8 @@ struct CurveJoin {
 };
 
 /// The open end that `candidate` (a new curve in the world frame) continues smoothly, by the
-/// checks of CurveExtensionOptions at either of its ends; the smallest pixel gap wins. Nothing
-/// when no end passes, or an end projects behind the camera.
+/// checks of CurveExtensionOptions at either of its ends; the smallest pixel gap wins. An end
+/// that projects behind the camera is not tried. Nothing when no end passes.
 std::optional<CurveJoin> findJoin(const PolyBezier& candidate, const std::vector<OpenEnd>& ends,
                                   const Pose3& cam_from_world, const Camera& camera,
                                   const CurveExtensionOptions& options);

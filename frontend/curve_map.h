@@ -134,6 +134,7 @@ class CurveMap {
   /// existing ones move with them when the curve grows at the front. The state is kept. Throws
   /// CheckError on a bad id or unless `extended` has more segments than the curve.
   void extendCurve(int id, const PolyBezier& extended, CurveEnd end);
+
   /// Ends keyframe `keyframe` (all its observations added): disabled curves seen in it are
   /// reactivated (to the global map if they had been promoted), temporary curves with enough
   /// observations promoted, and curves that went mostly unseen disabled. A curve seen in this

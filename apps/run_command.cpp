@@ -308,15 +308,28 @@ void printFrontendStages(const std::vector<KeyframeStats>& frames) {
       t.frontend_ms, t.slowest_frontend_ms);
 }
 
+// How the map grew over a run: curves started, and new curves appended to an existing one.
+struct CurveGrowth {
+  int started = 0;
+  int extended = 0;
+};
+
+CurveGrowth curveGrowth(const std::vector<KeyframeStats>& frames) {
+  CurveGrowth growth;
+  for (const KeyframeStats& s : frames) {
+    growth.started += s.new_curves;
+    growth.extended += s.extended_curves;
+  }
+  return growth;
+}
+
 void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
   double frontend = 0.0, local_ba = 0.0;
-  int started = 0, extended = 0;
   for (const KeyframeStats& s : r.frames) {
     frontend += s.frontendSeconds();
     local_ba += s.local_ba_seconds;
-    started += s.new_curves;
-    extended += s.extended_curves;
   }
+  const CurveGrowth growth = curveGrowth(r.frames);
   const CurveSampleCounts& samples = r.final_samples;
   std::printf(
       "run: %zu frames (%d of %d images without an initial pose skipped), %zu keyframes, "
@@ -324,7 +337,7 @@ void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
       d.frames.size(), d.images - static_cast<int>(d.frames.size()), d.images,
       r.keyframe_cam_from_world.size(), r.curves.size(), totalSegments(r.curves));
   std::printf("map: %d curves started, %d new curves appended to an existing curve's end\n",
-              started, extended);
+              growth.started, growth.extended);
   if (!r.global_ba.rounds.empty()) {
     std::printf("global BA: cost %.6g -> %.6g, %d iterations, %.2f s (%s)\n",
                 r.global_ba.initial_cost, r.global_ba.final_cost, r.global_ba.total_iterations,
@@ -439,6 +452,7 @@ int RunCommand::run() const {
   nlohmann::json frames = nlohmann::json::array();
   for (const KeyframeStats& s : result.frames) frames.push_back(frameToJson(s));
   const double seconds = secondsSince(start);
+  const CurveGrowth growth = curveGrowth(result.frames);
   writeJsonFile(joinPath(out_dir_, "report.json"),
                 {{"command", "run"},
                  {"config", optionsToJson(*command_)},
@@ -459,6 +473,8 @@ int RunCommand::run() const {
                    {"keyframes", result.keyframe_cam_from_world.size()},
                    {"curves", result.curves.size()},
                    {"segments", totalSegments(result.curves)},
+                   {"curves_started", growth.started},
+                   {"curves_extended", growth.extended},
                    {"overlays", overlays}}},
                  {"frames", frames},
                  {"global_ba", scheduleReportToJson(result.global_ba)},

@@ -197,6 +197,9 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   const nlohmann::json report = nlohmann::json::parse(report_file);
   EXPECT_EQ(report["counts"]["keyframes"], 6);
   EXPECT_GT(report["counts"]["curves"].get<int>(), 0);
+  // Every final curve was started once; extensions add none.
+  EXPECT_GE(report["counts"]["curves_started"].get<int>(), report["counts"]["curves"].get<int>());
+  EXPECT_GE(report["counts"]["curves_extended"].get<int>(), 0);
   EXPECT_EQ(report["frames"].size(), 6u);
   EXPECT_EQ(report["options"]["pipeline"]["local_ba"]["strategy"], "alternating");
   EXPECT_EQ(report["options"]["pipeline"]["global_ba"]["optimizer"]["max_iterations"], 10);

@@ -94,4 +94,17 @@ Pose3 Pose3::fromAmbient(const double* in) {
   return Pose3(Eigen::Quaterniond(in[3], in[0], in[1], in[2]), Eigen::Vector3d(in[4], in[5], in[6]));
 }
 
+double cameraCentreDistance(const Pose3& a_cam_from_world, const Pose3& b_cam_from_world) {
+  return (a_cam_from_world.inverseTranslation() - b_cam_from_world.inverseTranslation()).norm();
+}
+
+double meanCameraStep(const std::vector<Pose3>& cam_from_world) {
+  if (cam_from_world.size() < 2) return 0.0;
+  double sum = 0.0;
+  for (std::size_t i = 1; i < cam_from_world.size(); ++i) {
+    sum += cameraCentreDistance(cam_from_world[i], cam_from_world[i - 1]);
+  }
+  return sum / static_cast<double>(cam_from_world.size() - 1);
+}
+
 }  // namespace curvesfm

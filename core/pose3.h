@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <vector>
 
 #include "core/eigen_types.h"
 
@@ -62,5 +63,12 @@ class Pose3 {
   Eigen::Quaterniond rotation_;
   Eigen::Vector3d translation_;
 };
+
+/// Distance between the camera centres of two cam_from_world poses (their unit).
+double cameraCentreDistance(const Pose3& a_cam_from_world, const Pose3& b_cam_from_world);
+
+/// Mean distance between the camera centres of consecutive poses of a trajectory; 0 for fewer
+/// than two poses.
+double meanCameraStep(const std::vector<Pose3>& cam_from_world);
 
 }  // namespace curvesfm

@@ -55,22 +55,13 @@ void checkFields(const CurveBundleAdjustmentInput& input) {
   }
 }
 
-double meanStep(const std::vector<Pose3>& cam_from_world) {
-  double sum = 0.0;
-  for (std::size_t j = 1; j < cam_from_world.size(); ++j) {
-    sum += (cam_from_world[j].inverseTranslation() - cam_from_world[j - 1].inverseTranslation())
-               .norm();
-  }
-  return sum / static_cast<double>(cam_from_world.size() - 1);
-}
-
 void addMotionPrior(const std::vector<Pose3>& prior_cam_from_world,
                     const CurveBundleAdjustmentOptions& options, FactorGraph* graph) {
   if (prior_cam_from_world.size() < 2) return;
   const double rotation_sigma = options.motion_prior_rotation_sigma_deg * M_PI / 180.0;
   // A trajectory that never moves still gets a usable sigma: it pins the translations at zero.
-  const double translation_sigma =
-      options.motion_prior_translation_sigma_rel * std::max(meanStep(prior_cam_from_world), 1e-12);
+  const double translation_sigma = options.motion_prior_translation_sigma_rel *
+                                   std::max(meanCameraStep(prior_cam_from_world), 1e-12);
   for (std::size_t j = 1; j < prior_cam_from_world.size(); ++j) {
     const Pose3 cam_j_from_cam_i = prior_cam_from_world[j] * prior_cam_from_world[j - 1].inverse();
     graph->emplace<RelativePoseFactor>(poseKey(j - 1), poseKey(j), cam_j_from_cam_i, rotation_sigma,

@@ -43,10 +43,9 @@ bool KeyframeSelector::isKeyframe(const Pose3& cam_from_world) {
       options_.min_keyframe_translation == 0.0 && options_.min_keyframe_rotation_deg == 0.0;
   bool accept = !has_keyframe_ || every_frame;
   if (!accept) {
-    const double moved =
-        (cam_from_world.inverseTranslation() - last_keyframe_.inverseTranslation()).norm();
-    accept = moved > options_.min_keyframe_translation ||
-             rotationAngleDeg(cam_from_world, last_keyframe_) > options_.min_keyframe_rotation_deg;
+    accept =
+        cameraCentreDistance(cam_from_world, last_keyframe_) > options_.min_keyframe_translation ||
+        rotationAngleDeg(cam_from_world, last_keyframe_) > options_.min_keyframe_rotation_deg;
   }
   if (accept) {
     has_keyframe_ = true;

@@ -468,9 +468,8 @@ CurveBundleAdjustmentInput Pipeline::Impl::bundleInput(CurveSelection selection,
   }
   // The scale gauge: the initial baseline of the first two keyframes, so the map keeps the unit
   // of the initial poses.
-  input.scale_distance = (keyframes[1].initial_cam_from_world.inverseTranslation() -
-                          keyframes[0].initial_cam_from_world.inverseTranslation())
-                             .norm();
+  input.scale_distance = cameraCentreDistance(keyframes[1].initial_cam_from_world,
+                                              keyframes[0].initial_cam_from_world);
   *ids = map.exportCurves(selection, &input);
   return input;
 }

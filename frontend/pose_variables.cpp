@@ -9,10 +9,7 @@ void addScaleGauge(const std::vector<Pose3>& cam_from_world, double distance, do
                    FactorGraph* graph) {
   CURVESFM_CHECK(cam_from_world.size() >= 2) << "fixing the scale needs two poses";
   const double fixed =
-      distance > 0.0
-          ? distance
-          : (cam_from_world[1].inverseTranslation() - cam_from_world[0].inverseTranslation())
-                .norm();
+      distance > 0.0 ? distance : cameraCentreDistance(cam_from_world[1], cam_from_world[0]);
   graph->emplace<CameraDistanceFactor>(poseKey(0), poseKey(1), fixed, NoiseModel{sigma, {}});
 }
 

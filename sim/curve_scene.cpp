@@ -923,8 +923,7 @@ CurveScene makeCurveScene(const CurveSceneOptions& options) {
 }
 
 double CurveScene::trueScaleDistance() const {
-  return (true_cam_from_world[1].inverseTranslation() - true_cam_from_world[0].inverseTranslation())
-      .norm();
+  return cameraCentreDistance(true_cam_from_world[1], true_cam_from_world[0]);
 }
 
 CurveSceneErrors evaluateCurveScene(const CurveScene& scene,

@@ -217,22 +217,11 @@ cv::Mat renderPlanarView(const cv::Mat& texture_bgr, double plane_width_m, const
   return view;
 }
 
-double PlanarScene::meanFrameBaseline() const {
-  if (true_cam_from_world.size() < 2) return 0.0;
-  double sum = 0.0;
-  for (std::size_t i = 1; i < true_cam_from_world.size(); ++i) {
-    sum += (true_cam_from_world[i].inverseTranslation() -
-            true_cam_from_world[i - 1].inverseTranslation())
-               .norm();
-  }
-  return sum / (true_cam_from_world.size() - 1);
-}
+double PlanarScene::meanFrameBaseline() const { return meanCameraStep(true_cam_from_world); }
 
 double PlanarScene::firstToLastBaseline() const {
   if (true_cam_from_world.empty()) return 0.0;
-  return (true_cam_from_world.back().inverseTranslation() -
-          true_cam_from_world.front().inverseTranslation())
-      .norm();
+  return cameraCentreDistance(true_cam_from_world.back(), true_cam_from_world.front());
 }
 
 std::string toString(InitNoiseModel model) {

@@ -1,7 +1,7 @@
 #include "sim/point_scene.h"
 
-#include <cmath>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <random>
 
 #include "core/errors.h"
@@ -103,9 +103,7 @@ PointScene makePointScene(const PointSceneOptions& options) {
 }
 
 double PointScene::trueScaleDistance() const {
-  return (true_cam_from_world[1].inverseTranslation() -
-          true_cam_from_world[0].inverseTranslation())
-      .norm();
+  return cameraCentreDistance(true_cam_from_world[1], true_cam_from_world[0]);
 }
 
 PointSceneErrors evaluatePointScene(const PointScene& scene,

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "core/errors.h"
 #include "core/so3.h"
@@ -355,6 +356,20 @@ TEST(Pose3, FromAmbientNormalisesQuaternion) {
   const Eigen::Quaterniond expected(Eigen::AngleAxisd(kPi / 2.0, Eigen::Vector3d::UnitZ()));
   EXPECT_LE(pose.rotation().angularDistance(expected), 1e-15);
   EXPECT_NEAR(pose.rotation().norm(), 1.0, 1e-15);
+}
+
+// Camera centres are -R^T t: a camera turned away still has its centre where it stands.
+TEST(Pose3, CameraCentreDistanceAndMeanStepUseTheCentres) {
+  const Eigen::Quaterniond turned(Eigen::AngleAxisd(kPi / 2.0, Eigen::Vector3d::UnitY()));
+  const auto at = [&](const Eigen::Vector3d& centre) {
+    return Pose3(turned, -(turned.inverse() * centre));
+  };
+  const std::vector<Pose3> path = {at({0.0, 0.0, 0.0}), at({3.0, 4.0, 0.0}), at({3.0, 4.0, 1.0})};
+  EXPECT_NEAR(cameraCentreDistance(path[1], path[0]), 5.0, 1e-12);
+  EXPECT_NEAR(cameraCentreDistance(path[0], path[1]), 5.0, 1e-12);
+  EXPECT_NEAR(meanCameraStep(path), 3.0, 1e-12);
+  EXPECT_EQ(meanCameraStep({path[0]}), 0.0);
+  EXPECT_EQ(meanCameraStep({}), 0.0);
 }
 
 }  // namespace

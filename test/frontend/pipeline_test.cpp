@@ -5,9 +5,9 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <utility>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <utility>
 
 #include "core/errors.h"
 #include "sim/planar_scene.h"
@@ -115,9 +115,8 @@ double largestMoveWithoutGlobalBa(bool local_ba_refines_poses) {
   const PipelineResult result = runFiveFramesWithoutGlobalBa(options);
   double largest = 0.0;
   for (std::size_t j = 0; j < result.keyframe_cam_from_world.size(); ++j) {
-    largest = std::max(largest, (result.keyframe_cam_from_world[j].inverseTranslation() -
-                                 result.keyframe_initial_cam_from_world[j].inverseTranslation())
-                                    .norm());
+    largest = std::max(largest, cameraCentreDistance(result.keyframe_cam_from_world[j],
+                                                     result.keyframe_initial_cam_from_world[j]));
   }
   return largest;
 }

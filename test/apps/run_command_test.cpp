@@ -153,6 +153,13 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   result = run("--reassociation-rounds -1");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("PipelineOptions.reassociation_rounds = -1"));
+  result = run("--extend-max-angle 0");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("CurveExtensionOptions.max_angle_deg = 0"));
+  result = run("--ba-motion-prior-translation -0.1");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output,
+              HasSubstr("CurveBundleAdjustmentOptions.motion_prior_translation_sigma_rel"));
   result = run("--local-ba-strategy sideways");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--local-ba-strategy"));

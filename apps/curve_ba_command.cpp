@@ -4,9 +4,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "apps/cli_options.h"
+#include "apps/cli/cli_options.h"
+#include "apps/cli/report_json.h"
 #include "core/errors.h"
-#include "frontend/pose_variables.h"
+#include "factors/pose_variables.h"
 #include "sim/curve_scene_input.h"
 
 namespace curvesfm {

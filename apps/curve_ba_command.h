@@ -3,7 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "frontend/curve_bundle_adjustment.h"
+#include "factors/curve_bundle_adjustment.h"
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
 

@@ -8,7 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "apps/cli_options.h"
+#include "apps/cli/cli_options.h"
+#include "apps/cli/report_json.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
 #include "core/trajectory_plot.h"

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "apps/cli_options.h"
+#include "apps/cli/cli_options.h"
 #include "apps/curve_ba_command.h"
 #include "apps/eval_command.h"
 #include "apps/point_ba_command.h"
@@ -13,7 +13,8 @@
 #include "core/errors.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"curvesfm: curve-based structure from motion (poly-Bezier curves + bundle adjustment)"};
+  CLI::App app{
+      "curvesfm: curve-based structure from motion (poly-Bezier curves + bundle adjustment)"};
   app.name("curvesfm");  // for the usage line; parsing a vector does not read argv[0]
   app.require_subcommand(1);
   // A flag given in the config file and again on the command line: the last one wins.

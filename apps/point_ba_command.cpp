@@ -5,17 +5,19 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "apps/cli_options.h"
+#include "apps/cli/cli_options.h"
+#include "apps/cli/report_json.h"
 #include "core/errors.h"
 
 namespace curvesfm {
 namespace {
 
 void printErrors(const char* label, const PointSceneErrors& errors) {
-  std::printf("%-8s camera ATE (sim3) %.6f m, position rmse %.6f m, rotation mean %.5f deg, "
-              "point rmse %.6f m, reprojection rmse %.4f px\n",
-              label, errors.position_ate_sim3, errors.position_rmse, errors.rotation_mean_deg,
-              errors.point_rmse, errors.reprojection_rmse_px);
+  std::printf(
+      "%-8s camera ATE (sim3) %.6f m, position rmse %.6f m, rotation mean %.5f deg, "
+      "point rmse %.6f m, reprojection rmse %.4f px\n",
+      label, errors.position_ate_sim3, errors.position_rmse, errors.rotation_mean_deg,
+      errors.point_rmse, errors.reprojection_rmse_px);
 }
 
 nlohmann::json errorsToJson(const PointSceneErrors& errors) {
@@ -62,17 +64,17 @@ int PointBaCommand::run() const {
 
   const PointScene scene = makePointScene(scene_);
   std::printf("scene: %zu cameras, %zu points, %zu observations (seed %u)\n",
-              scene.true_cam_from_world.size(), scene.true_points.size(),
-              scene.observations.size(), scene_.seed);
-  PointBundleAdjustmentProblem problem = buildPointBundleAdjustment(
-      {scene.camera, scene.initial_cam_from_world, scene.initial_points, scene.observations,
-       scene.trueScaleDistance()},
-      ba_);
+              scene.true_cam_from_world.size(), scene.true_points.size(), scene.observations.size(),
+              scene_.seed);
+  PointBundleAdjustmentProblem problem =
+      buildPointBundleAdjustment({scene.camera, scene.initial_cam_from_world, scene.initial_points,
+                                  scene.observations, scene.trueScaleDistance()},
+                                 ba_);
   const PointSceneErrors before =
       evaluatePointScene(scene, scene.initial_cam_from_world, scene.initial_points);
 
-  const OptimizationSummary summary = optimize(problem.graph, &problem.values, problem.config,
-                                               optimizer_);
+  const OptimizationSummary summary =
+      optimize(problem.graph, &problem.values, problem.config, optimizer_);
   const PointSceneErrors after =
       evaluatePointScene(scene, extractPoses(problem.values, scene.true_cam_from_world.size()),
                          extractPoints(problem.values, scene.true_points.size()));

@@ -3,7 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "frontend/point_bundle_adjustment.h"
+#include "factors/point_bundle_adjustment.h"
 #include "graph/optimizer.h"
 #include "sim/point_scene.h"
 

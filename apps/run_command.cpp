@@ -11,13 +11,15 @@
 #include <string>
 #include <vector>
 
-#include "apps/cli_options.h"
-#include "apps/config_file.h"
-#include "apps/pipeline_flags.h"
+#include "apps/cli/cli_options.h"
+#include "apps/cli/config_file.h"
+#include "apps/cli/pipeline_flags.h"
+#include "apps/cli/report_json.h"
 #include "core/curve_export.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
 #include "core/trajectory_evaluation.h"
+#include "core/tum_dataset.h"
 
 namespace curvesfm {
 namespace {
@@ -31,109 +33,8 @@ nlohmann::json overlayOptionsToJson(const CurveOverlayOptions& o) {
           {"point_radius_px", o.point_radius_px}};
 }
 
-// ---------------------------------------------------------------------------------------------
-// Input.
-
-struct Frame {
-  double timestamp = 0.0;
-  std::string image_path;
-  Pose3 initial_cam_from_world;
-};
-
-struct Dataset {
-  std::string camera_path, rgb_path, init_poses_path, ground_truth_path;
-  std::optional<Camera> camera;
-  int images = 0;                         // Listed in rgb.txt.
-  std::vector<Frame> frames;              // Images with an initial pose, in rgb.txt order.
-  std::vector<StampedPose> ground_truth;  // Empty without groundtruth.txt.
-};
-
 std::string joinPath(const std::string& dir, const std::string& name) {
   return (fs::path(dir) / name).string();
-}
-
-// DIR/init_poses.txt unless --init-poses names a file; until an automatic initialiser exists
-// a run cannot start without one.
-std::string initPosesPath(const std::string& dataset_dir, const std::string& flag) {
-  if (!flag.empty()) return flag;
-  const std::string fallback = joinPath(dataset_dir, "init_poses.txt");
-  if (fs::exists(fallback)) return fallback;
-  throw IoError(fallback,
-                "no such file and no --init-poses given; an automatic initialiser is not "
-                "available yet: pass --init-poses FILE, a TUM trajectory "
-                "'timestamp tx ty tz qx qy qz qw' (camera-to-world) covering the images");
-}
-
-std::string timeSpan(const std::vector<double>& times) {
-  char text[64];
-  const auto [low, high] = std::minmax_element(times.begin(), times.end());
-  std::snprintf(text, sizeof(text), "%.6f .. %.6f s", *low, *high);
-  return text;
-}
-
-std::vector<Frame> matchFrames(const std::vector<ImageEntry>& images,
-                               const std::vector<StampedPose>& poses, double max_dt,
-                               const Dataset& d) {
-  std::vector<StampedPose> image_times(images.size());
-  std::vector<double> image_stamps, pose_stamps;
-  for (std::size_t i = 0; i < images.size(); ++i) {
-    image_times[i].timestamp = images[i].timestamp;
-    image_stamps.push_back(images[i].timestamp);
-  }
-  for (const StampedPose& pose : poses) pose_stamps.push_back(pose.timestamp);
-  std::vector<Frame> frames;
-  for (const TimestampMatch& m : associateByTimestamp(image_times, poses, max_dt)) {
-    const ImageEntry& image = images[m.estimate_index];
-    frames.push_back(
-        {image.timestamp, image.path, poses[m.ground_truth_index].world_from_cam.inverse()});
-  }
-  if (frames.empty()) {
-    char within[32];
-    std::snprintf(within, sizeof(within), "%g", max_dt);
-    throw ParseError(
-        d.init_poses_path, 0,
-        "poses within " + std::string(within) + " s of the images of " + d.rgb_path + " (" +
-            timeSpan(image_stamps) + ")",
-        "none of its " + std::to_string(poses.size()) + " poses (" + timeSpan(pose_stamps) + ")");
-  }
-  return frames;
-}
-
-// A missing file or one whose header names no format OpenCV reads fails here, before any
-// work, with readColorImage()'s message; decoding waits for the run.
-void checkImageFile(const std::string& path) {
-  if (!fs::exists(path) || !cv::haveImageReader(path)) readColorImage(path);
-}
-
-// Reads every file but the images, so that a bad one fails before any work; images are
-// checked here and decoded one at a time during the run.
-Dataset loadDataset(const std::string& dir, const std::string& init_poses_flag, double max_dt) {
-  Dataset d;
-  d.camera_path = joinPath(dir, "camera.yaml");
-  d.rgb_path = joinPath(dir, "rgb.txt");
-  d.camera.emplace(readCameraYaml(d.camera_path));
-  const std::vector<ImageEntry> images = readImageList(d.rgb_path);
-  d.images = static_cast<int>(images.size());
-  d.init_poses_path = initPosesPath(dir, init_poses_flag);
-  d.frames = matchFrames(images, readTrajectory(d.init_poses_path), max_dt, d);
-  const std::string ground_truth = joinPath(dir, "groundtruth.txt");
-  if (fs::exists(ground_truth)) {
-    d.ground_truth_path = ground_truth;
-    d.ground_truth = readTrajectory(ground_truth);
-  }
-  for (const Frame& frame : d.frames) checkImageFile(frame.image_path);
-  return d;
-}
-
-cv::Mat loadImage(const Frame& frame, const Camera& camera) {
-  cv::Mat image = readColorImage(frame.image_path);
-  if (image.cols != camera.width() || image.rows != camera.height()) {
-    throw IoError(frame.image_path, "is " + std::to_string(image.cols) + "x" +
-                                        std::to_string(image.rows) + " px, camera.yaml says " +
-                                        std::to_string(camera.width()) + "x" +
-                                        std::to_string(camera.height()));
-  }
-  return image;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -155,25 +56,16 @@ void printProgress(const KeyframeStats& s, int frames) {
   std::fflush(stdout);
 }
 
-std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const Dataset& d) {
+std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const TumDataset& d) {
   std::vector<KeyframeStats> stats;
   const int n = static_cast<int>(d.frames.size());
-  for (const Frame& frame : d.frames) {
+  for (const DatasetFrame& frame : d.frames) {
     const KeyframeStats s = pipeline->addFrame(
-        {frame.timestamp, loadImage(frame, *d.camera), frame.initial_cam_from_world});
+        {frame.timestamp, loadFrameImage(frame, *d.camera), frame.initial_cam_from_world});
     if (s.keyframe_index >= 0) printProgress(s, n);
     stats.push_back(s);
   }
   return stats;
-}
-
-std::vector<StampedPose> stamped(const std::vector<double>& timestamps,
-                                 const std::vector<Pose3>& cam_from_world) {
-  std::vector<StampedPose> poses(timestamps.size());
-  for (std::size_t k = 0; k < poses.size(); ++k) {
-    poses[k] = {timestamps[k], cam_from_world[k].inverse()};
-  }
-  return poses;
 }
 
 // ATE (Sim(3)) of the initial and refined keyframe trajectories, when there is a ground truth.
@@ -182,16 +74,16 @@ struct AteResult {
   std::string problem;  // Why they are missing, if they are.
 };
 
-AteResult evaluateAte(const PipelineResult& r, const Dataset& d) {
+AteResult evaluateAte(const PipelineResult& r, const TumDataset& d) {
   AteResult ate;
   if (d.ground_truth.empty()) return ate;
   try {
     const TrajectoryEvaluationOptions options;  // Sim(3), 0.02 s.
     ate.initial =
-        compareTrajectories(stamped(r.keyframe_timestamps, r.keyframe_initial_cam_from_world),
+        compareTrajectories(stampedPoses(r.keyframe_timestamps, r.keyframe_initial_cam_from_world),
                             d.ground_truth, options, "initial keyframes", d.ground_truth_path);
     ate.refined =
-        compareTrajectories(stamped(r.keyframe_timestamps, r.keyframe_cam_from_world),
+        compareTrajectories(stampedPoses(r.keyframe_timestamps, r.keyframe_cam_from_world),
                             d.ground_truth, options, "refined keyframes", d.ground_truth_path);
   } catch (const TrajectoryEvaluationError& e) {
     ate.problem = e.what();
@@ -323,7 +215,7 @@ CurveGrowth curveGrowth(const std::vector<KeyframeStats>& frames) {
   return growth;
 }
 
-void printSummary(const Dataset& d, const PipelineResult& r, double seconds) {
+void printSummary(const TumDataset& d, const PipelineResult& r, double seconds) {
   double frontend = 0.0, local_ba = 0.0;
   for (const KeyframeStats& s : r.frames) {
     frontend += s.frontendSeconds();
@@ -428,7 +320,7 @@ void RunCommand::validate() const {
 int RunCommand::run() const {
   validate();
   const Clock::time_point start = Clock::now();
-  const Dataset d = loadDataset(dataset_dir_, init_poses_path_, max_dt_);
+  const TumDataset d = loadTumDataset(dataset_dir_, init_poses_path_, max_dt_);
   std::error_code error;
   fs::create_directories(out_dir_, error);
   if (error) throw IoError(out_dir_, "cannot create the output folder: " + error.message());
@@ -442,7 +334,7 @@ int RunCommand::run() const {
   const AteResult ate = evaluateAte(result, d);
 
   writeTrajectory(joinPath(out_dir_, "trajectory.txt"),
-                  stamped(result.keyframe_timestamps, result.keyframe_cam_from_world));
+                  stampedPoses(result.keyframe_timestamps, result.keyframe_cam_from_world));
   writeCurvesPly(joinPath(out_dir_, "curves.ply"), result.curves, export_samples_per_segment_);
   writeCurvesObj(joinPath(out_dir_, "curves.obj"), result.curves, export_samples_per_segment_);
   writeConfigYaml(joinPath(out_dir_, "config.yaml"), *command_);

@@ -3,8 +3,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "frontend/curve_overlay.h"
-#include "frontend/pipeline.h"
+#include "frontend/image/curve_overlay.h"
+#include "frontend/mapping/pipeline.h"
 
 namespace curvesfm {
 

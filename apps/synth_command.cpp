@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "apps/cli_options.h"
+#include "apps/cli/cli_options.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
 

@@ -20,8 +20,8 @@
 
 #include "benchmarks/support/bench_common.h"
 #include "core/errors.h"
-#include "frontend/curve_bundle_adjustment.h"
-#include "frontend/point_bundle_adjustment.h"
+#include "factors/curve_bundle_adjustment.h"
+#include "factors/point_bundle_adjustment.h"
 #include "graph/ceres_cost_function.h"
 #include "sim/curve_scene.h"
 #include "sim/curve_scene_input.h"
@@ -61,8 +61,7 @@ class EvaluationSet {
     double elapsed = 0.0;
     do {
       for (std::size_t k = 0; k < functions_.size(); ++k) {
-        functions_[k]->Evaluate(parameters_[k].data(), residuals.data(),
-                                jacobian_pointers.data());
+        functions_[k]->Evaluate(parameters_[k].data(), residuals.data(), jacobian_pointers.data());
         *checksum += residuals[0] + jacobians[0][0];
       }
       ++passes;
@@ -92,13 +91,14 @@ struct BenchOptions {
   CurveSceneOptions curve_scene;
   PointSceneOptions point_scene;
   CurveBundleAdjustmentOptions curve_ba;
-  int runs = 5;               ///< Timed runs; the median is reported; >= 1.
-  double run_seconds = 0.5;   ///< Minimum duration of one timed run (s); > 0.
+  int runs = 5;              ///< Timed runs; the median is reported; >= 1.
+  double run_seconds = 0.5;  ///< Minimum duration of one timed run (s); > 0.
 };
 
 EvaluationSet curveFactorsAtTruth(const BenchOptions& options) {
   const CurveScene scene = makeCurveScene(options.curve_scene);
-  const CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene, SceneStart::kTruth);
+  const CurveBundleAdjustmentInput input =
+      makeCurveBundleAdjustmentInput(scene, SceneStart::kTruth);
   const CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options.curve_ba);
   const CurveSampleCounts counts = countCurveSamples(problem.graph, problem.values);
   bench::printInt("curve_samples", counts.total());
@@ -120,8 +120,9 @@ EvaluationSet pointFactorsAtTruth(const BenchOptions& options) {
 }
 
 int run(const BenchOptions& options) {
-  std::printf("# curve_factor_bench: residual + ambient Jacobians per curve sample vs per point "
-              "observation\n");
+  std::printf(
+      "# curve_factor_bench: residual + ambient Jacobians per curve sample vs per point "
+      "observation\n");
   const EvaluationSet curves = curveFactorsAtTruth(options);
   const EvaluationSet points = pointFactorsAtTruth(options);
   const long long samples = curves.rows();

@@ -31,9 +31,9 @@
 #include "benchmarks/support/bench_common.h"
 #include "core/camera.h"
 #include "core/pose3.h"
-#include "frontend/edge_chains.h"
-#include "frontend/edge_detector.h"
-#include "frontend/epipolar_depth.h"
+#include "frontend/image/edge_chains.h"
+#include "frontend/image/edge_detector.h"
+#include "frontend/image/epipolar_depth.h"
 #include "sim/planar_scene.h"
 
 namespace curvesfm {

@@ -25,9 +25,9 @@
 
 #include "benchmarks/support/bench_common.h"
 #include "core/camera.h"
-#include "frontend/edge_chains.h"
-#include "frontend/edge_detector.h"
-#include "frontend/image_undistorter.h"
+#include "frontend/image/edge_chains.h"
+#include "frontend/image/edge_detector.h"
+#include "frontend/image/image_undistorter.h"
 
 namespace curvesfm {
 namespace {

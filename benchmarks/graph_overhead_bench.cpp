@@ -38,9 +38,9 @@
 #include "core/camera.h"
 #include "core/errors.h"
 #include "core/pose3.h"
+#include "factors/point_bundle_adjustment.h"
 #include "factors/point_reprojection_factor.h"
 #include "factors/pose_prior_factor.h"
-#include "frontend/point_bundle_adjustment.h"
 #include "graph/ceres_cost_function.h"
 #include "graph/ceres_manifolds.h"
 #include "graph/ceres_problem.h"
@@ -414,7 +414,6 @@ JacobianComparison compareJacobians(const EvaluationSet& analytic, const Evaluat
 }
 
 // --- output ----------------------------------------------------------------------------------
-
 
 int run(const BenchOptions& bench) {
   const PointScene scene = makePointScene(bench.scene);

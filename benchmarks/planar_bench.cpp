@@ -38,15 +38,15 @@
 #include <utility>
 #include <vector>
 
-#include "apps/cli_options.h"
-#include "apps/config_file.h"
-#include "apps/pipeline_flags.h"
+#include "apps/cli/cli_options.h"
+#include "apps/cli/config_file.h"
+#include "apps/cli/pipeline_flags.h"
 #include "benchmarks/support/bench_common.h"
 #include "core/errors.h"
 #include "core/plot.h"
-#include "frontend/pipeline.h"
+#include "core/trajectory_evaluation.h"
+#include "frontend/mapping/pipeline.h"
 #include "sim/planar_scene.h"
-#include "sim/trajectory_errors.h"
 
 namespace curvesfm {
 namespace {

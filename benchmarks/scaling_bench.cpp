@@ -46,7 +46,7 @@
 #include "benchmarks/support/bench_common.h"
 #include "core/check.h"
 #include "core/errors.h"
-#include "frontend/curve_bundle_adjustment.h"
+#include "factors/curve_bundle_adjustment.h"
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
 #include "sim/curve_scene_input.h"

@@ -13,12 +13,12 @@
 // (deg), curve error = mean distance of sampled curve points to the true curve after the same
 // alignment (mm).
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
-#include <cmath>
-#include <algorithm>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -28,7 +28,7 @@
 #include "benchmarks/support/bench_common.h"
 #include "core/errors.h"
 #include "core/plot.h"
-#include "frontend/curve_bundle_adjustment.h"
+#include "factors/curve_bundle_adjustment.h"
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
 #include "sim/curve_scene_input.h"
@@ -101,8 +101,8 @@ struct PreparedScene {
 PreparedScene prepare(const NamedScene& named) {
   PreparedScene prepared{named.name, makeCurveScene(named.options), {}, {}};
   prepared.input = makeCurveBundleAdjustmentInput(prepared.scene);
-  prepared.before = evaluateCurveScene(prepared.scene, prepared.input.cam_from_world,
-                                       prepared.input.curves);
+  prepared.before =
+      evaluateCurveScene(prepared.scene, prepared.input.cam_from_world, prepared.input.curves);
   return prepared;
 }
 
@@ -126,9 +126,9 @@ Run solve(const PreparedScene& prepared, const Config& config, int max_iteration
   run.scene = prepared.name;
   run.config = config;
   run.before = prepared.before;
-  run.after = evaluateCurveScene(
-      prepared.scene, extractPoses(problem.values, prepared.input.cam_from_world.size()),
-      extractCurves(problem.values, prepared.input.curves));
+  run.after = evaluateCurveScene(prepared.scene,
+                                 extractPoses(problem.values, prepared.input.cam_from_world.size()),
+                                 extractCurves(problem.values, prepared.input.curves));
   run.iterations = report.total_iterations;
   run.final_cost = report.final_cost;
   run.converged = report.converged;
@@ -137,8 +137,7 @@ Run solve(const PreparedScene& prepared, const Config& config, int max_iteration
 
 std::vector<Config> sweepConfigs() {
   std::vector<Config> configs;
-  for (Strategy strategy :
-       {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
+  for (Strategy strategy : {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
     for (LinearSolver solver :
          {LinearSolver::kSparseSchur, LinearSolver::kDenseSchur, LinearSolver::kIterativeSchur}) {
       for (RobustKernelType kernel :
@@ -200,14 +199,13 @@ void writeCsv(const std::vector<Run>& runs, const std::filesystem::path& path) {
          "rotation_before_deg,rotation_after_deg,curve_before_mm,curve_after_mm,iterations,"
          "seconds,final_cost,converged\n";
   for (const Run& r : runs) {
-    out << r.scene << "," << toString(r.config.strategy) << "," << toString(r.config.solver)
-        << "," << toString(r.config.kernel) << "," << r.config.lambda1 << ","
-        << r.config.lambda2 << "," << (r.config.subpixel ? "subpixel" : "integer") << ","
-        << 1e3 * r.before.position_ate_sim3 << "," << 1e3 * r.after.position_ate_sim3 << ","
-        << r.before.rotation_mean_deg << "," << r.after.rotation_mean_deg << ","
-        << 1e3 * r.before.curve_mean_error_aligned << ","
-        << 1e3 * r.after.curve_mean_error_aligned << "," << r.iterations << "," << r.seconds
-        << "," << r.final_cost << "," << (r.converged ? 1 : 0) << "\n";
+    out << r.scene << "," << toString(r.config.strategy) << "," << toString(r.config.solver) << ","
+        << toString(r.config.kernel) << "," << r.config.lambda1 << "," << r.config.lambda2 << ","
+        << (r.config.subpixel ? "subpixel" : "integer") << "," << 1e3 * r.before.position_ate_sim3
+        << "," << 1e3 * r.after.position_ate_sim3 << "," << r.before.rotation_mean_deg << ","
+        << r.after.rotation_mean_deg << "," << 1e3 * r.before.curve_mean_error_aligned << ","
+        << 1e3 * r.after.curve_mean_error_aligned << "," << r.iterations << "," << r.seconds << ","
+        << r.final_cost << "," << (r.converged ? 1 : 0) << "\n";
   }
 }
 
@@ -259,8 +257,7 @@ void plotErrorVsTime(const std::vector<Run>& runs, bool curve, const std::filesy
   options.log_x = true;
   options.log_y = true;
   Plot plot(options);
-  for (Strategy strategy :
-       {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
+  for (Strategy strategy : {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
     PlotSeries series;
     series.label = toString(strategy);
     series.style = PlotSeries::Style::kMarkers;
@@ -268,8 +265,8 @@ void plotErrorVsTime(const std::vector<Run>& runs, bool curve, const std::filesy
     for (const Run& run : runs) {
       if (run.config.strategy != strategy) continue;
       series.x.push_back(run.seconds);
-      series.y.push_back(1e3 * (curve ? run.after.curve_mean_error_aligned
-                                      : run.after.position_ate_sim3));
+      series.y.push_back(
+          1e3 * (curve ? run.after.curve_mean_error_aligned : run.after.position_ate_sim3));
     }
     plot.add(series);
   }
@@ -310,8 +307,7 @@ void plotKernels(const std::vector<Aggregate>& sweep, const std::filesystem::pat
   options.y_label = "ATE after BA (mm)";
   options.value_labels = true;
   BarChart chart({"none", "huber", "cauchy"}, options);
-  for (Strategy strategy :
-       {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
+  for (Strategy strategy : {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
     BarSeries series;
     series.label = toString(strategy);
     for (RobustKernelType kernel :
@@ -354,16 +350,15 @@ int run(const BenchOptions& options) {
     for (const PreparedScene& scene : scenes) {
       runs.push_back(solve(scene, config, options.max_iterations));
       if (++done % 20 == 0 || done == total) {
-        std::fprintf(stderr, "\r%d / %d runs, %.0f s", done, total,
-                     bench::secondsSince(start));
+        std::fprintf(stderr, "\r%d / %d runs, %.0f s", done, total, bench::secondsSince(start));
       }
     }
   }
   std::fprintf(stderr, "\n");
   const std::vector<Aggregate> sweep = aggregate(runs);
-  const Aggregate best = *std::min_element(
-      sweep.begin(), sweep.end(),
-      [](const Aggregate& a, const Aggregate& b) { return a.ate_mm < b.ate_mm; });
+  const Aggregate best =
+      *std::min_element(sweep.begin(), sweep.end(),
+                        [](const Aggregate& a, const Aggregate& b) { return a.ate_mm < b.ate_mm; });
 
   std::vector<Run> edge_runs;
   for (bool subpixel : {false, true}) {

@@ -390,4 +390,15 @@ void writeCameraYaml(const std::string& path, const Camera& camera) {
   });
 }
 
+std::vector<StampedPose> stampedPoses(const std::vector<double>& timestamps,
+                                      const std::vector<Pose3>& cam_from_world) {
+  CURVESFM_CHECK(timestamps.size() == cam_from_world.size())
+      << timestamps.size() << " timestamps for " << cam_from_world.size() << " poses";
+  std::vector<StampedPose> poses(timestamps.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    poses[k] = {timestamps[k], cam_from_world[k].inverse()};
+  }
+  return poses;
+}
+
 }  // namespace curvesfm

@@ -69,6 +69,11 @@ std::vector<StampedPose> readTrajectory(const std::string& path);
 /// readTrajectory() rejects). Throws IoError if the file cannot be written.
 void writeTrajectory(const std::string& path, const std::vector<StampedPose>& poses);
 
+/// Pairs timestamps[k] with cam_from_world[k] as the camera-to-world StampedPose a TUM file
+/// holds. CheckError unless both have the same size.
+std::vector<StampedPose> stampedPoses(const std::vector<double>& timestamps,
+                                      const std::vector<Pose3>& cam_from_world);
+
 /// Reads an OpenCV FileStorage YAML camera file with ORB-SLAM2-style keys. Required: Camera.fx,
 /// Camera.fy (> 0), Camera.cx, Camera.cy, Camera.width, Camera.height (positive whole numbers);
 /// optional, default 0: Camera.k1, Camera.k2, Camera.p1, Camera.p2, Camera.k3. Other keys are

@@ -20,36 +20,6 @@ std::string formatNumber(double value) {
   return out.str();
 }
 
-struct Candidate {
-  double dt;
-  int estimate_index;
-  int ground_truth_index;
-};
-
-// Every (estimate, ground truth) pair within max_dt, found by a binary search in the
-// ground-truth stamps so that long trajectories do not cost |estimate| * |ground truth|.
-std::vector<Candidate> candidatePairs(const std::vector<StampedPose>& estimate,
-                                      const std::vector<StampedPose>& ground_truth, double max_dt) {
-  std::vector<int> by_time(ground_truth.size());
-  std::iota(by_time.begin(), by_time.end(), 0);
-  const auto earlier = [&](int a, int b) {
-    return ground_truth[a].timestamp < ground_truth[b].timestamp;
-  };
-  std::stable_sort(by_time.begin(), by_time.end(), earlier);
-  std::vector<Candidate> candidates;
-  for (std::size_t i = 0; i < estimate.size(); ++i) {
-    const double t = estimate[i].timestamp;
-    auto it =
-        std::lower_bound(by_time.begin(), by_time.end(), t - max_dt,
-                         [&](int g, double value) { return ground_truth[g].timestamp < value; });
-    for (; it != by_time.end() && ground_truth[*it].timestamp <= t + max_dt; ++it) {
-      const double dt = std::abs(ground_truth[*it].timestamp - t);
-      if (dt <= max_dt) candidates.push_back({dt, static_cast<int>(i), *it});
-    }
-  }
-  return candidates;
-}
-
 // The camera centres (world_from_cam translations) of the matched poses of one trajectory, as
 // columns; `side` picks the index into `poses` from a match.
 Eigen::Matrix3Xd matchedCentres(const std::vector<StampedPose>& poses,
@@ -117,6 +87,38 @@ void computeRelativeErrors(TrajectoryEvaluation* evaluation) {
   evaluation->rpe_rotation_stats = computeErrorStatistics(evaluation->rpe_rotation_deg);
 }
 
+void checkSameSize(const std::vector<Pose3>& truth, const std::vector<Pose3>& estimate) {
+  CURVESFM_CHECK(truth.size() == estimate.size())
+      << "trajectories differ in length: " << truth.size() << " true vs " << estimate.size()
+      << " estimated poses";
+  CURVESFM_CHECK(truth.size() >= 2) << "an alignment needs at least 2 poses, got " << truth.size();
+}
+
+// Centre, then (optionally) the three axis tips of every camera, as the columns of a matrix.
+Eigen::Matrix3Xd cameraFramePoints(const std::vector<Pose3>& cam_from_world, double axis_length) {
+  const int per_camera = axis_length > 0.0 ? 4 : 1;
+  Eigen::Matrix3Xd points(3, per_camera * static_cast<Eigen::Index>(cam_from_world.size()));
+  for (std::size_t i = 0; i < cam_from_world.size(); ++i) {
+    const Eigen::Vector3d centre = cam_from_world[i].inverseTranslation();
+    const Eigen::Index column = per_camera * static_cast<Eigen::Index>(i);
+    points.col(column) = centre;
+    if (per_camera == 1) continue;
+    // The rows of R (cam_from_world) are the camera axes in the world.
+    const Eigen::Matrix3d axes = cam_from_world[i].rotationMatrix().transpose();
+    for (int a = 0; a < 3; ++a) points.col(column + 1 + a) = centre + axis_length * axes.col(a);
+  }
+  return points;
+}
+
+// Pose k stamped with time k, camera-to-world as StampedPose holds it.
+std::vector<StampedPose> stampedByIndex(const std::vector<Pose3>& cam_from_world) {
+  std::vector<StampedPose> poses(cam_from_world.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    poses[k] = {static_cast<double>(k), cam_from_world[k].inverse()};
+  }
+  return poses;
+}
+
 }  // namespace
 
 void TrajectoryEvaluationOptions::validate() const {
@@ -156,31 +158,6 @@ ErrorStatistics computeErrorStatistics(const std::vector<double>& errors) {
   return stats;
 }
 
-std::vector<TimestampMatch> associateByTimestamp(const std::vector<StampedPose>& estimate,
-                                                 const std::vector<StampedPose>& ground_truth,
-                                                 double max_dt) {
-  CURVESFM_CHECK(std::isfinite(max_dt) && max_dt >= 0.0) << "max_dt = " << max_dt;
-  std::vector<Candidate> candidates = candidatePairs(estimate, ground_truth, max_dt);
-  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-    return std::tie(a.dt, a.estimate_index, a.ground_truth_index) <
-           std::tie(b.dt, b.estimate_index, b.ground_truth_index);
-  });
-  std::vector<bool> estimate_used(estimate.size(), false);
-  std::vector<bool> ground_truth_used(ground_truth.size(), false);
-  std::vector<TimestampMatch> matches;
-  for (const Candidate& c : candidates) {
-    if (estimate_used[c.estimate_index] || ground_truth_used[c.ground_truth_index]) continue;
-    estimate_used[c.estimate_index] = true;
-    ground_truth_used[c.ground_truth_index] = true;
-    matches.push_back({c.estimate_index, c.ground_truth_index});
-  }
-  std::sort(matches.begin(), matches.end(), [&](const TimestampMatch& a, const TimestampMatch& b) {
-    return std::make_pair(estimate[a.estimate_index].timestamp, a.estimate_index) <
-           std::make_pair(estimate[b.estimate_index].timestamp, b.estimate_index);
-  });
-  return matches;
-}
-
 TrajectoryEvaluationError::TrajectoryEvaluationError(const std::string& estimate_name,
                                                      const std::string& ground_truth_name,
                                                      const std::string& problem)
@@ -215,6 +192,48 @@ TrajectoryEvaluation compareTrajectories(const std::vector<StampedPose>& estimat
   evaluation.ate = computeErrorStatistics(position_errors);
   computeRelativeErrors(&evaluation);
   return evaluation;
+}
+
+Sim3 alignCameraCentres(const std::vector<Pose3>& true_cam_from_world,
+                        const std::vector<Pose3>& estimated_cam_from_world) {
+  checkSameSize(true_cam_from_world, estimated_cam_from_world);
+  return alignPointSets(cameraFramePoints(estimated_cam_from_world, 0.0),
+                        cameraFramePoints(true_cam_from_world, 0.0), AlignmentKind::kSim3);
+}
+
+Sim3 alignCameraFrames(const std::vector<Pose3>& true_cam_from_world,
+                       const std::vector<Pose3>& estimated_cam_from_world, double axis_length) {
+  checkSameSize(true_cam_from_world, estimated_cam_from_world);
+  CURVESFM_CHECK(axis_length > 0.0) << "axis_length must be > 0, got " << axis_length;
+  // The estimate's axes are drawn at the length that the centres' scale maps to axis_length,
+  // so that an exact similarity between the trajectories is recovered exactly.
+  const double scale = alignCameraCentres(true_cam_from_world, estimated_cam_from_world).scale;
+  return alignPointSets(cameraFramePoints(estimated_cam_from_world, axis_length / scale),
+                        cameraFramePoints(true_cam_from_world, axis_length), AlignmentKind::kSim3);
+}
+
+TrajectoryErrors evaluateTrajectory(const std::vector<Pose3>& true_cam_from_world,
+                                    const std::vector<Pose3>& estimated_cam_from_world) {
+  checkSameSize(true_cam_from_world, estimated_cam_from_world);
+  TrajectoryEvaluationOptions by_index;
+  by_index.max_dt = 0.0;  // Pose k is stamped k on both sides, so only k matches k.
+  const TrajectoryEvaluation ate =
+      compareTrajectories(stampedByIndex(estimated_cam_from_world),
+                          stampedByIndex(true_cam_from_world), by_index, "estimated", "true");
+  TrajectoryErrors errors;
+  errors.position_ate_sim3 = ate.ate.rmse;
+  const std::size_t num_cameras = true_cam_from_world.size();
+  for (std::size_t i = 0; i < num_cameras; ++i) {
+    const Pose3& truth = true_cam_from_world[i];
+    const Pose3& estimate = estimated_cam_from_world[i];
+    errors.position_rmse +=
+        (estimate.inverseTranslation() - truth.inverseTranslation()).squaredNorm();
+    errors.rotation_mean_deg +=
+        so3::log(estimate.rotation() * truth.rotation().conjugate()).norm() * kRadToDeg;
+  }
+  errors.position_rmse = std::sqrt(errors.position_rmse / num_cameras);
+  errors.rotation_mean_deg /= num_cameras;
+  return errors;
 }
 
 }  // namespace curvesfm

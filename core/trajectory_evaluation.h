@@ -7,6 +7,7 @@
 #include "core/errors.h"
 #include "core/pose3.h"
 #include "core/similarity_alignment.h"
+#include "core/timestamp_association.h"
 
 namespace curvesfm {
 
@@ -48,20 +49,6 @@ struct ErrorStatistics {
 
 /// Statistics of `errors` (any finite values; none gives the all-zero ErrorStatistics).
 ErrorStatistics computeErrorStatistics(const std::vector<double>& errors);
-
-/// One estimated pose paired with the ground-truth pose nearest in time.
-struct TimestampMatch {
-  int estimate_index = 0;      ///< Index into the estimated trajectory.
-  int ground_truth_index = 0;  ///< Index into the ground-truth trajectory.
-};
-
-/// Pairs estimated and ground-truth poses one-to-one by timestamp, as TUM's associate.py: among
-/// all pairs with |t_estimate - t_ground_truth| <= max_dt, the closest in time are taken first and
-/// each pose is used at most once. Neither trajectory needs to be sorted. Returns the matches in
-/// the estimate's time order (ties by file order). max_dt must be finite and >= 0 (CheckError).
-std::vector<TimestampMatch> associateByTimestamp(const std::vector<StampedPose>& estimate,
-                                                 const std::vector<StampedPose>& ground_truth,
-                                                 double max_dt);
 
 /// A matched pose after alignment.
 struct MatchedPose {
@@ -113,5 +100,42 @@ TrajectoryEvaluation compareTrajectories(const std::vector<StampedPose>& estimat
                                          const TrajectoryEvaluationOptions& options,
                                          const std::string& estimate_name = "estimate",
                                          const std::string& ground_truth_name = "ground truth");
+
+// ---------------------------------------------------------------------------------------------
+// Index-aligned trajectories (synthetic scenes): both are cam_from_world with pose k of each the
+// same frame.
+
+/// The Umeyama (least-squares, with scale) Sim(3) truth_from_estimated that maps the estimated
+/// camera centres onto the true ones. Both trajectories are cam_from_world, index-aligned, and
+/// must have the same size >= 2 (CheckError otherwise). With fewer than 3 non-collinear centres
+/// (a straight walk) the rotation about their line is not determined; use alignCameraFrames.
+Sim3 alignCameraCentres(const std::vector<Pose3>& true_cam_from_world,
+                        const std::vector<Pose3>& estimated_cam_from_world);
+
+/// Like alignCameraCentres, but every camera also contributes the tips of its three axes:
+/// centre + axis_length * (x, y, z axis of the camera in the world) for the truth, and the same
+/// with axis_length / s for the estimate, s being alignCameraCentres' scale (axis_length in m,
+/// > 0). The rotation is then determined by the camera orientations even when all centres lie on
+/// one line, and an exact similarity between the trajectories is recovered exactly. Use it to
+/// carry structure (points, curves) into the true frame.
+Sim3 alignCameraFrames(const std::vector<Pose3>& true_cam_from_world,
+                       const std::vector<Pose3>& estimated_cam_from_world, double axis_length);
+
+/// Pose errors of an estimated trajectory against the truth (same contract as above).
+struct TrajectoryErrors {
+  /// RMS camera-centre error in the solver's gauge, without alignment (m).
+  double position_rmse = 0.0;
+  /// RMS camera-centre error after alignCameraCentres (m): the absolute trajectory error (ATE),
+  /// free of the drift that a gauge of one camera and one baseline lets accumulate.
+  double position_ate_sim3 = 0.0;
+  /// Mean angle of R_estimated * R_true^T over the cameras, without alignment (deg).
+  double rotation_mean_deg = 0.0;
+};
+
+/// Index-matched evaluation (synthetic scenes, where pose k of both trajectories is the same
+/// frame): position_ate_sim3 is compareTrajectories()' ATE rmse, the figure `run` and `eval`
+/// report, so every ATE in the project comes from one code. Needs >= 3 poses.
+TrajectoryErrors evaluateTrajectory(const std::vector<Pose3>& true_cam_from_world,
+                                    const std::vector<Pose3>& estimated_cam_from_world);
 
 }  // namespace curvesfm

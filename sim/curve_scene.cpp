@@ -18,7 +18,7 @@
 #include "core/check.h"
 #include "core/errors.h"
 #include "core/so3.h"
-#include "sim/trajectory_errors.h"
+#include "core/trajectory_evaluation.h"
 
 namespace curvesfm {
 namespace {

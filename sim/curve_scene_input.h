@@ -3,7 +3,7 @@
 #include <memory>
 #include <vector>
 
-#include "frontend/curve_bundle_adjustment.h"
+#include "factors/curve_bundle_adjustment.h"
 #include "sim/curve_scene.h"
 
 namespace curvesfm {

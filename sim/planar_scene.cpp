@@ -124,15 +124,6 @@ std::string imageName(std::size_t frame) {
   return name;
 }
 
-std::vector<StampedPose> stamped(const std::vector<double>& timestamps,
-                                 const std::vector<Pose3>& cam_from_world) {
-  std::vector<StampedPose> poses;
-  for (std::size_t i = 0; i < timestamps.size(); ++i) {
-    poses.push_back({timestamps[i], cam_from_world[i].inverse()});
-  }
-  return poses;
-}
-
 }  // namespace
 
 CameraIntrinsics PlanarSceneOptions::intrinsics() const {
@@ -281,9 +272,9 @@ void writePlanarDataset(const std::string& dir, const PlanarScene& scene) {
   writeImageList((root / "rgb.txt").string(), entries);
   writeCameraYaml((root / "camera.yaml").string(), *scene.camera);
   writeTrajectory((root / "groundtruth.txt").string(),
-                  stamped(scene.timestamps, scene.true_cam_from_world));
+                  stampedPoses(scene.timestamps, scene.true_cam_from_world));
   writeTrajectory((root / "init_poses.txt").string(),
-                  stamped(scene.timestamps, scene.initial_cam_from_world));
+                  stampedPoses(scene.timestamps, scene.initial_cam_from_world));
 }
 
 }  // namespace curvesfm

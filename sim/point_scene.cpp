@@ -6,7 +6,7 @@
 
 #include "core/errors.h"
 #include "core/so3.h"
-#include "sim/trajectory_errors.h"
+#include "core/trajectory_evaluation.h"
 
 namespace curvesfm {
 namespace {

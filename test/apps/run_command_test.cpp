@@ -15,6 +15,7 @@
 
 #include "core/dataset_io.h"
 #include "sim/planar_scene.h"
+#include "test/apps/run_command_fixture.h"
 #include "test/support/run_executable.h"
 
 namespace curvesfm {
@@ -24,74 +25,9 @@ using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
 using testing::CommandResult;
+using testing::ringsTexture;
+using testing::RunCommandTest;
 using testing::runCurvesfm;
-
-// Rings and bars of several colours on a grey ground: curved and straight edges in every
-// direction for the planar views.
-cv::Mat ringsTexture() {
-  cv::Mat texture(240, 320, CV_8UC3, cv::Scalar(120, 120, 120));
-  for (int i = 0; i < 4; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      const cv::Point centre(40 + 80 * i, 40 + 80 * j);
-      const cv::Scalar colour(60 * i, 255 - 80 * j, 40 + 50 * (i + j));
-      if ((i + j) % 2 == 0) {
-        cv::circle(texture, centre, 18 + 4 * j, colour, cv::FILLED, cv::LINE_AA);
-      } else {
-        cv::rectangle(texture, centre - cv::Point(20, 12), centre + cv::Point(20, 12), colour,
-                      cv::FILLED);
-      }
-    }
-  }
-  return texture;
-}
-
-class RunCommandTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    folder_ = std::filesystem::path(::testing::TempDir()) /
-              ("run_command_test_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(folder_);
-    std::filesystem::create_directories(folder_ / "rgb");
-  }
-  void TearDown() override { std::filesystem::remove_all(folder_); }
-
-  std::string path(const std::string& name) const { return (folder_ / name).string(); }
-
-  // Three 40 x 30 grey frames 0.1 s apart, their list, a camera and initial poses.
-  void writeTinyDataset() const {
-    CameraIntrinsics k;
-    k.fx = k.fy = 40.0;
-    k.cx = 19.5;
-    k.cy = 14.5;
-    k.width = 40;
-    k.height = 30;
-    writeCameraYaml(path("camera.yaml"), Camera(k));
-    std::vector<ImageEntry> images;
-    std::vector<StampedPose> poses;
-    for (int i = 0; i < 3; ++i) {
-      const std::string name = "rgb/" + std::to_string(i) + ".png";
-      writeImage(path(name), cv::Mat(30, 40, CV_8UC3, cv::Scalar(100, 100, 100)));
-      images.push_back({1.0 + 0.1 * i, name});
-      poses.push_back({1.0 + 0.1 * i, Pose3()});
-    }
-    writeImageList(path("rgb.txt"), images);
-    writeTrajectory(path("init_poses.txt"), poses);
-  }
-
-  CommandResult run(const std::string& extra = "") const {
-    return runCurvesfm("run --dataset " + folder_.string() + " --out " + path("out") + " " + extra);
-  }
-
-  // A failed run: exit 1, one line that starts with `start`, and no output folder.
-  void expectOneLineError(const CommandResult& result, const std::string& start) const {
-    EXPECT_EQ(result.exit_code, 1) << result.output;
-    EXPECT_THAT(result.output, StartsWith(start));
-    EXPECT_EQ(std::count(result.output.begin(), result.output.end(), '\n'), 1) << result.output;
-    EXPECT_FALSE(std::filesystem::exists(path("out")));
-  }
-
-  std::filesystem::path folder_;
-};
 
 TEST_F(RunCommandTest, MissingRgbListNamesTheFile) {
   writeTinyDataset();
@@ -169,65 +105,5 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
 
 // A short orbit over a planar photo, every frame a keyframe: all outputs are written and read
 // back, and the configuration written beside them runs again.
-TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
-  PlanarSceneOptions options;
-  options.num_frames = 6;
-  options.arc_degrees = 15.0;
-  options.width = 240;
-  options.height = 180;
-  options.fx = options.fy = 200.0;
-  options.cx = 119.5;
-  options.cy = 89.5;
-  options.intensity_noise = 0.01;
-  options.init_noise_model = InitNoiseModel::kIndependent;
-  options.init_noise_translation = 0.005;
-  options.init_noise_rotation_deg = 0.2;
-  const std::string dataset = path("planar");
-  writePlanarDataset(dataset, makePlanarScene(ringsTexture(), options));
-  const std::string out = path("planar_out");
-  const std::string flags =
-      " --map-keyframe-translation 0 --map-keyframe-rotation 0 --global-ba-max-iterations 10";
-  const CommandResult result =
-      runCurvesfm("run --dataset " + dataset + " --out " + out + " --overlays" + flags);
-  ASSERT_EQ(result.exit_code, 0) << result.output;
-  EXPECT_THAT(result.output, HasSubstr("frame 1/6 keyframe 0: curves "));
-  EXPECT_THAT(result.output, HasSubstr("frame 6/6 keyframe 5: curves "));
-  EXPECT_THAT(result.output, HasSubstr("run: 6 frames (0 of 6 images without an initial pose"));
-  EXPECT_THAT(result.output, HasSubstr("ATE (sim3) vs " + dataset + "/groundtruth.txt"));
-  EXPECT_THAT(result.output, HasSubstr("frontend per keyframe (mean ms): undistort "));
-
-  EXPECT_EQ(readTrajectory(out + "/trajectory.txt").size(), 6u);
-  for (const char* name : {"curves.ply", "curves.obj", "config.yaml", "overlays/000005.png"}) {
-    EXPECT_TRUE(std::filesystem::exists(out + "/" + name)) << name;
-  }
-  std::ifstream report_file(out + "/report.json");
-  const nlohmann::json report = nlohmann::json::parse(report_file);
-  EXPECT_EQ(report["counts"]["keyframes"], 6);
-  EXPECT_GT(report["counts"]["curves"].get<int>(), 0);
-  // Every final curve was started once; extensions add none.
-  EXPECT_GE(report["counts"]["curves_started"].get<int>(), report["counts"]["curves"].get<int>());
-  EXPECT_GE(report["counts"]["curves_extended"].get<int>(), 0);
-  EXPECT_EQ(report["frames"].size(), 6u);
-  EXPECT_EQ(report["options"]["pipeline"]["local_ba"]["strategy"], "alternating");
-  EXPECT_EQ(report["options"]["pipeline"]["global_ba"]["optimizer"]["max_iterations"], 10);
-  EXPECT_EQ(report["options"]["pipeline"]["map"]["min_keyframe_translation"], 0.0);
-  EXPECT_TRUE(report["global_ba"].contains("rounds"));
-  EXPECT_EQ(report["options"]["pipeline"]["pipeline"]["reassociation_rounds"], 3);
-  ASSERT_TRUE(report["reassociation"].is_array());
-  for (const auto& round : report["reassociation"]) {
-    EXPECT_GT(round["added_observations"].get<int>(), 0);
-    EXPECT_TRUE(round["global_ba"].contains("rounds"));
-  }
-  EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));
-  EXPECT_TRUE(report["ate"]["refined_m"].contains("rmse"));
-
-  // config.yaml holds every flag in force: a rerun from it alone writes the same keyframes.
-  const CommandResult again =
-      runCurvesfm("run --config " + out + "/config.yaml --out " + path("again"));
-  ASSERT_EQ(again.exit_code, 0) << again.output;
-  EXPECT_EQ(readTrajectory(path("again") + "/trajectory.txt").size(), 6u);
-  EXPECT_TRUE(std::filesystem::exists(path("again") + "/overlays/000005.png"));
-}
-
 }  // namespace
 }  // namespace curvesfm

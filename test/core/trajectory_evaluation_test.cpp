@@ -7,6 +7,8 @@
 #include <cmath>
 #include <random>
 
+#include "core/errors.h"
+
 namespace curvesfm {
 namespace {
 
@@ -268,6 +270,37 @@ TEST(TrajectoryEvaluationOptions, RejectsInvalidValues) {
                  "(frames)");
   }
   EXPECT_THROW(compareTrajectories(helix(5), helix(5), options), InvalidOptions);
+}
+
+// The index-matched entry of synthetic scenes: the same ATE as compareTrajectories on the same
+// poses, a similarity of the truth scores zero, and the unaligned figures see the similarity.
+TEST(EvaluateTrajectory, IsTheAteOfCompareTrajectoriesMatchedByIndex) {
+  const std::vector<StampedPose> truth = helix(20);
+  std::vector<StampedPose> estimate = transformed(exampleSim3(), truth);
+  std::mt19937 random(7);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (StampedPose& pose : estimate) {
+    pose.world_from_cam = Pose3(pose.world_from_cam.rotation(),
+                                pose.world_from_cam.translation() +
+                                    Eigen::Vector3d(noise(random), noise(random), noise(random)));
+  }
+  std::vector<Pose3> true_cam_from_world, estimated_cam_from_world;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    true_cam_from_world.push_back(truth[k].world_from_cam.inverse());
+    estimated_cam_from_world.push_back(estimate[k].world_from_cam.inverse());
+  }
+  const TrajectoryErrors errors = evaluateTrajectory(true_cam_from_world, estimated_cam_from_world);
+  const TrajectoryEvaluation by_time = compareTrajectories(estimate, truth, {});
+  // Equal up to the rounding of inverting the poses.
+  EXPECT_NEAR(errors.position_ate_sim3, by_time.ate.rmse, 1e-12);
+  EXPECT_GT(errors.position_rmse, 1.0);
+
+  const TrajectoryErrors exact = evaluateTrajectory(
+      true_cam_from_world,
+      std::vector<Pose3>(true_cam_from_world.begin(), true_cam_from_world.end()));
+  EXPECT_LT(exact.position_ate_sim3, 1e-12);
+  EXPECT_LT(exact.rotation_mean_deg, 1e-9);
+  EXPECT_THROW(evaluateTrajectory(true_cam_from_world, {}), CheckError);
 }
 
 }  // namespace

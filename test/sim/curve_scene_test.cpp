@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/errors.h"
-#include "sim/trajectory_errors.h"
+#include "core/trajectory_evaluation.h"
 
 namespace curvesfm {
 namespace {

@@ -1,0 +1,102 @@
+#include "apps/cli/report_json.h"
+
+#include <fstream>
+
+#include "core/errors.h"
+
+namespace curvesfm {
+
+nlohmann::json costsToJson(const std::map<std::string, FactorTypeCost>& costs) {
+  nlohmann::json json = nlohmann::json::object();
+  for (const auto& [type, cost] : costs) json[type] = {{"count", cost.count}, {"cost", cost.cost}};
+  return json;
+}
+
+nlohmann::json optimizerOptionsToJson(const OptimizerOptions& options) {
+  return {{"linear_solver", toString(options.linear_solver)},
+          {"trust_region", toString(options.trust_region)},
+          {"max_iterations", options.max_iterations},
+          {"num_threads", options.num_threads},
+          {"function_tolerance", options.function_tolerance},
+          {"gradient_tolerance", options.gradient_tolerance},
+          {"parameter_tolerance", options.parameter_tolerance},
+          {"structure_first_ordering", options.structure_first_ordering},
+          {"use_inner_iterations", options.use_inner_iterations},
+          {"verbose", options.verbose}};
+}
+
+nlohmann::json schedulerOptionsToJson(const SchedulerOptions& options) {
+  return {{"strategy", toString(options.strategy)},
+          {"scope", toString(options.scope)},
+          {"local_window", options.local_window},
+          {"max_rounds", options.max_rounds},
+          {"round_tolerance", options.round_tolerance},
+          {"fix_first_pose", options.fix_first_pose},
+          {"optimizer", optimizerOptionsToJson(options.optimizer)}};
+}
+
+nlohmann::json scheduleReportToJson(const ScheduleReport& report) {
+  nlohmann::json rounds = nlohmann::json::array();
+  for (const ScheduleRound& round : report.rounds) {
+    nlohmann::json entry = {
+        {"round", round.round}, {"phase", round.phase}, {"skipped", round.skipped}};
+    if (!round.skipped) entry["summary"] = summaryToJson(round.summary);
+    rounds.push_back(entry);
+  }
+  return {{"strategy", toString(report.strategy)},
+          {"scope", toString(report.scope)},
+          {"num_rounds", report.num_rounds},
+          {"num_factors", report.num_factors},
+          {"num_active_factors", report.num_active_factors},
+          {"initial_cost", report.initial_cost},
+          {"final_cost", report.final_cost},
+          {"total_iterations", report.total_iterations},
+          {"total_seconds", report.total_seconds},
+          {"converged", report.converged},
+          {"stop_reason", report.stop_reason},
+          {"warnings", report.warnings},
+          {"rounds", rounds}};
+}
+
+nlohmann::json summaryToJson(const OptimizationSummary& summary) {
+  return {
+      {"initial_cost", summary.initial_cost},
+      {"final_cost", summary.final_cost},
+      {"cost_convention", "0.5 * sum rho(|r / sigma|^2)"},
+      {"initial_cost_by_type", costsToJson(summary.initial_cost_by_type)},
+      {"final_cost_by_type", costsToJson(summary.final_cost_by_type)},
+      {"iterations", summary.iterations},
+      {"usable", summary.usable},
+      {"termination", summary.termination},
+      {"message", summary.message},
+      {"linear_solver", summary.linear_solver},
+      {"ordering", summary.ordering},
+      {"num_factors", summary.num_factors},
+      {"num_free_variables", summary.num_free_variables},
+      {"num_constant_variables", summary.num_constant_variables},
+      {"num_residuals", summary.num_residuals},
+      {"num_effective_parameters", summary.num_effective_parameters},
+      {"seconds",
+       {{"setup", summary.setup_seconds},
+        {"solve", summary.solve_seconds},
+        {"minimizer", summary.minimizer_seconds},
+        {"writeback", summary.writeback_seconds},
+        {"total", summary.total_seconds}}},
+  };
+}
+
+nlohmann::json sampleCountsToJson(const CurveSampleCounts& counts) {
+  return {{"on_field", counts.on_field},
+          {"behind_camera", counts.behind_camera},
+          {"outside_image", counts.outside_image},
+          {"beyond_reach", counts.beyond_reach},
+          {"wrong_orientation", counts.wrong_orientation},
+          {"total", counts.total()}};
+}
+
+void writeJsonFile(const std::string& path, const nlohmann::json& json) {
+  std::ofstream out(path);
+  if (!(out << json.dump(2) << "\n")) throw IoError(path, "cannot write");
+}
+
+}  // namespace curvesfm

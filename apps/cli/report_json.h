@@ -1,0 +1,35 @@
+#pragma once
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "factors/curve_reprojection_factor.h"
+#include "graph/optimizer.h"
+#include "graph/scheduler.h"
+
+namespace curvesfm {
+
+// The pieces of the commands' report.json files that several commands share.
+
+/// An OptimizationSummary as a JSON object (for report.json).
+nlohmann::json summaryToJson(const OptimizationSummary& summary);
+
+/// Costs per factor type as {type: {count, cost}} (for report.json).
+nlohmann::json costsToJson(const std::map<std::string, FactorTypeCost>& costs);
+
+/// Every field of the options as a JSON object, enums by name (for report.json).
+nlohmann::json optimizerOptionsToJson(const OptimizerOptions& options);
+nlohmann::json schedulerOptionsToJson(const SchedulerOptions& options);
+
+/// A ScheduleReport as a JSON object: totals, stop reason, warnings and every phase with its
+/// solver summary (for report.json).
+nlohmann::json scheduleReportToJson(const ScheduleReport& report);
+
+/// Where curve samples fall (CurveSampleCounts) as a JSON object with a total.
+nlohmann::json sampleCountsToJson(const CurveSampleCounts& counts);
+
+/// Writes `json` (indented) to `path`; IoError naming the path if it cannot.
+void writeJsonFile(const std::string& path, const nlohmann::json& json);
+
+}  // namespace curvesfm

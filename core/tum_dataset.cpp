@@ -1,0 +1,107 @@
+#include "core/tum_dataset.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/errors.h"
+#include "core/timestamp_association.h"
+
+namespace curvesfm {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string joinPath(const std::string& dir, const std::string& name) {
+  return (fs::path(dir) / name).string();
+}
+
+// DIR/init_poses.txt unless --init-poses names a file; until an automatic initialiser exists
+// a run cannot start without one.
+std::string initPosesPath(const std::string& dataset_dir, const std::string& flag) {
+  if (!flag.empty()) return flag;
+  const std::string fallback = joinPath(dataset_dir, "init_poses.txt");
+  if (fs::exists(fallback)) return fallback;
+  throw IoError(fallback,
+                "no such file and no --init-poses given; an automatic initialiser is not "
+                "available yet: pass --init-poses FILE, a TUM trajectory "
+                "'timestamp tx ty tz qx qy qz qw' (camera-to-world) covering the images");
+}
+
+std::string timeSpan(const std::vector<double>& times) {
+  char text[64];
+  const auto [low, high] = std::minmax_element(times.begin(), times.end());
+  std::snprintf(text, sizeof(text), "%.6f .. %.6f s", *low, *high);
+  return text;
+}
+
+std::vector<DatasetFrame> matchFrames(const std::vector<ImageEntry>& images,
+                                      const std::vector<StampedPose>& poses, double max_dt,
+                                      const TumDataset& d) {
+  std::vector<StampedPose> image_times(images.size());
+  std::vector<double> image_stamps, pose_stamps;
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    image_times[i].timestamp = images[i].timestamp;
+    image_stamps.push_back(images[i].timestamp);
+  }
+  for (const StampedPose& pose : poses) pose_stamps.push_back(pose.timestamp);
+  std::vector<DatasetFrame> frames;
+  for (const TimestampMatch& m : associateByTimestamp(image_times, poses, max_dt)) {
+    const ImageEntry& image = images[m.estimate_index];
+    frames.push_back(
+        {image.timestamp, image.path, poses[m.ground_truth_index].world_from_cam.inverse()});
+  }
+  if (frames.empty()) {
+    char within[32];
+    std::snprintf(within, sizeof(within), "%g", max_dt);
+    throw ParseError(
+        d.init_poses_path, 0,
+        "poses within " + std::string(within) + " s of the images of " + d.rgb_path + " (" +
+            timeSpan(image_stamps) + ")",
+        "none of its " + std::to_string(poses.size()) + " poses (" + timeSpan(pose_stamps) + ")");
+  }
+  return frames;
+}
+
+// A missing file or one whose header names no format OpenCV reads fails here, before any
+// work, with readColorImage()'s message; decoding waits for the run.
+void checkImageFile(const std::string& path) {
+  if (!fs::exists(path) || !cv::haveImageReader(path)) readColorImage(path);
+}
+
+// Reads every file but the images, so that a bad one fails before any work; images are
+// checked here and decoded one at a time during the run.
+}  // namespace
+
+TumDataset loadTumDataset(const std::string& dir, const std::string& init_poses_flag,
+                          double max_dt) {
+  TumDataset d;
+  d.camera_path = joinPath(dir, "camera.yaml");
+  d.rgb_path = joinPath(dir, "rgb.txt");
+  d.camera.emplace(readCameraYaml(d.camera_path));
+  const std::vector<ImageEntry> images = readImageList(d.rgb_path);
+  d.images = static_cast<int>(images.size());
+  d.init_poses_path = initPosesPath(dir, init_poses_flag);
+  d.frames = matchFrames(images, readTrajectory(d.init_poses_path), max_dt, d);
+  const std::string ground_truth = joinPath(dir, "groundtruth.txt");
+  if (fs::exists(ground_truth)) {
+    d.ground_truth_path = ground_truth;
+    d.ground_truth = readTrajectory(ground_truth);
+  }
+  for (const DatasetFrame& frame : d.frames) checkImageFile(frame.image_path);
+  return d;
+}
+
+cv::Mat loadFrameImage(const DatasetFrame& frame, const Camera& camera) {
+  cv::Mat image = readColorImage(frame.image_path);
+  if (image.cols != camera.width() || image.rows != camera.height()) {
+    throw IoError(frame.image_path, "is " + std::to_string(image.cols) + "x" +
+                                        std::to_string(image.rows) + " px, camera.yaml says " +
+                                        std::to_string(camera.width()) + "x" +
+                                        std::to_string(camera.height()));
+  }
+  return image;
+}
+
+}  // namespace curvesfm

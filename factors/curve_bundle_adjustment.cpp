@@ -1,0 +1,180 @@
+#include "factors/curve_bundle_adjustment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/check.h"
+#include "core/errors.h"
+#include "factors/relative_pose_factor.h"
+#include "factors/segment_length_factor.h"
+#include "factors/tangent_alignment_factor.h"
+
+namespace curvesfm {
+namespace {
+
+void insertCurve(std::uint32_t c, const PolyBezier& curve, Values* values) {
+  for (int i = 0; i < curve.numPoints(); ++i) {
+    values->insert(curvePointKey(c, i), curve.points()[i]);
+    values->insert(directionKey(c, i), curve.directions()[i]);
+  }
+  for (int i = 0; i < curve.numSegments(); ++i) {
+    values->insert(startLengthKey(c, i), curve.lengths()[i].d1);
+    values->insert(endLengthKey(c, i), curve.lengths()[i].d2);
+  }
+}
+
+void addRegularisers(std::uint32_t c, const PolyBezier& curve,
+                     const CurveBundleAdjustmentOptions& options, FactorGraph* graph) {
+  for (int i = 0; i < curve.numSegments(); ++i) {
+    const SegmentKeys keys = segmentKeys(c, i);
+    if (options.lambda1 > 0.0) {
+      const double length = (curve.points()[i + 1] - curve.points()[i]).norm();
+      graph->emplace<SegmentLengthFactor>(keys.q0, keys.q1, length,
+                                          NoiseModel{1.0 / std::sqrt(options.lambda1), {}});
+    }
+    if (options.lambda2 > 0.0) {
+      graph->emplace<TangentAlignmentFactor>(keys.q0, keys.q1, keys.v0, keys.v1,
+                                             NoiseModel{1.0 / std::sqrt(options.lambda2), {}});
+    }
+  }
+}
+
+void checkFields(const CurveBundleAdjustmentInput& input) {
+  CURVESFM_CHECK(input.fields.size() == input.cam_from_world.size())
+      << "curve bundle adjustment: " << input.fields.size() << " edge fields for "
+      << input.cam_from_world.size() << " keyframes";
+  const CameraIntrinsics& intrinsics = input.camera->intrinsics();
+  for (std::size_t j = 0; j < input.fields.size(); ++j) {
+    CURVESFM_CHECK(input.fields[j] != nullptr) << "keyframe " << j << " has no edge field";
+    CURVESFM_CHECK(input.fields[j]->width() == intrinsics.width &&
+                   input.fields[j]->height() == intrinsics.height)
+        << "keyframe " << j << ": edge field " << input.fields[j]->width() << "x"
+        << input.fields[j]->height() << " but camera " << intrinsics.width << "x"
+        << intrinsics.height;
+  }
+}
+
+void addMotionPrior(const std::vector<Pose3>& prior_cam_from_world,
+                    const CurveBundleAdjustmentOptions& options, FactorGraph* graph) {
+  if (prior_cam_from_world.size() < 2) return;
+  const double rotation_sigma = options.motion_prior_rotation_sigma_deg * M_PI / 180.0;
+  // A trajectory that never moves still gets a usable sigma: it pins the translations at zero.
+  const double translation_sigma = options.motion_prior_translation_sigma_rel *
+                                   std::max(meanCameraStep(prior_cam_from_world), 1e-12);
+  for (std::size_t j = 1; j < prior_cam_from_world.size(); ++j) {
+    const Pose3 cam_j_from_cam_i = prior_cam_from_world[j] * prior_cam_from_world[j - 1].inverse();
+    graph->emplace<RelativePoseFactor>(poseKey(j - 1), poseKey(j), cam_j_from_cam_i, rotation_sigma,
+                                       translation_sigma);
+  }
+}
+
+}  // namespace
+
+void CurveBundleAdjustmentOptions::validate() const {
+  const char* name = "CurveBundleAdjustmentOptions";
+  if (samples_per_segment < 1 || samples_per_segment >= CurveReprojectionFactor::kMaxSamples) {
+    throw InvalidOptions(
+        name, "samples_per_segment", std::to_string(samples_per_segment),
+        "must be in [1, " + std::to_string(CurveReprojectionFactor::kMaxSamples - 1) + "]");
+  }
+  auto positive = [&](double value, const char* field) {
+    if (!(value > 0.0 && std::isfinite(value))) {
+      throw InvalidOptions(name, field, std::to_string(value), "must be > 0 and finite");
+    }
+  };
+  auto non_negative = [&](double value, const char* field) {
+    if (!(value >= 0.0 && std::isfinite(value))) {
+      throw InvalidOptions(name, field, std::to_string(value), "must be >= 0 and finite");
+    }
+  };
+  if (!(max_normal_angle_deg > 0.0 && max_normal_angle_deg <= 90.0)) {
+    throw InvalidOptions(name, "max_normal_angle_deg", std::to_string(max_normal_angle_deg),
+                         "must be in (0, 90]");
+  }
+  positive(pixel_sigma, "pixel_sigma");
+  positive(kernel_width, "kernel_width");
+  non_negative(lambda1, "lambda1");
+  non_negative(lambda2, "lambda2");
+  positive(scale_sigma, "scale_sigma");
+  positive(motion_prior_rotation_sigma_deg, "motion_prior_rotation_sigma_deg");
+  positive(motion_prior_translation_sigma_rel, "motion_prior_translation_sigma_rel");
+}
+
+CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
+    const CurveBundleAdjustmentInput& input, const CurveBundleAdjustmentOptions& options) {
+  options.validate();
+  CURVESFM_CHECK(input.camera != nullptr) << "curve bundle adjustment needs a camera";
+  checkFields(input);
+  CurveBundleAdjustmentProblem problem;
+  const int num_keyframes = static_cast<int>(input.cam_from_world.size());
+  for (int j = 0; j < num_keyframes; ++j)
+    problem.values.insert(poseKey(j), input.cam_from_world[j]);
+  for (std::size_t c = 0; c < input.curves.size(); ++c) {
+    insertCurve(static_cast<std::uint32_t>(c), input.curves[c], &problem.values);
+    addRegularisers(static_cast<std::uint32_t>(c), input.curves[c], options, &problem.graph);
+  }
+
+  const auto sampling = std::make_shared<const CurveSampling>(
+      options.samples_per_segment + 1, options.use_subpixel_edges, options.max_normal_angle_deg);
+  const NoiseModel pixel_noise{options.pixel_sigma,
+                               RobustKernel(options.kernel, options.kernel_width)};
+  const int num_curves = static_cast<int>(input.curves.size());
+  for (const SegmentObservation& obs : input.observations) {
+    CURVESFM_CHECK(obs.keyframe >= 0 && obs.keyframe < num_keyframes && obs.curve >= 0 &&
+                   obs.curve < num_curves && obs.segment >= 0 &&
+                   obs.segment < input.curves[obs.curve].numSegments())
+        << "observation of segment " << obs.segment << " of curve " << obs.curve << " in keyframe "
+        << obs.keyframe << " is out of range (" << num_curves << " curves, " << num_keyframes
+        << " keyframes)";
+    problem.graph.emplace<CurveReprojectionFactor>(
+        poseKey(obs.keyframe), segmentKeys(obs.curve, obs.segment), input.fields[obs.keyframe],
+        input.camera, sampling, pixel_noise);
+  }
+
+  if (options.fix_first_pose && num_keyframes > 0) problem.config.setConstant(poseKey(0));
+  if (options.fix_scale) {
+    addScaleGauge(input.cam_from_world, input.scale_distance, options.scale_sigma, &problem.graph);
+  }
+  if (options.motion_prior && !input.motion_prior_cam_from_world.empty()) {
+    CURVESFM_CHECK(input.motion_prior_cam_from_world.size() == input.cam_from_world.size())
+        << "curve bundle adjustment: " << input.motion_prior_cam_from_world.size()
+        << " motion-prior poses for " << num_keyframes << " keyframes";
+    addMotionPrior(input.motion_prior_cam_from_world, options, &problem.graph);
+  }
+  return problem;
+}
+
+std::vector<PolyBezier> extractCurves(const Values& values, const std::vector<PolyBezier>& layout) {
+  constexpr double kMinLength = 1e-9;
+  std::vector<PolyBezier> curves;
+  curves.reserve(layout.size());
+  for (std::size_t c = 0; c < layout.size(); ++c) {
+    const auto curve = static_cast<std::uint32_t>(c);
+    std::vector<Eigen::Vector3d> points;
+    std::vector<Direction> directions;
+    std::vector<SegmentLengths> lengths;
+    for (int i = 0; i < layout[c].numPoints(); ++i) {
+      points.push_back(values.at<Eigen::Vector3d>(curvePointKey(curve, i)));
+      directions.push_back(values.at<Direction>(directionKey(curve, i)));
+    }
+    for (int i = 0; i < layout[c].numSegments(); ++i) {
+      lengths.push_back({std::max(kMinLength, values.at<double>(startLengthKey(curve, i))),
+                         std::max(kMinLength, values.at<double>(endLengthKey(curve, i)))});
+    }
+    curves.emplace_back(std::move(points), std::move(directions), std::move(lengths));
+  }
+  return curves;
+}
+
+CurveSampleCounts countCurveSamples(const FactorGraph& graph, const Values& values) {
+  CurveSampleCounts counts;
+  for (const auto& factor : graph) {
+    if (const auto* curve = dynamic_cast<const CurveReprojectionFactor*>(factor.get())) {
+      counts += curve->sampleCounts(values);
+    }
+  }
+  return counts;
+}
+
+}  // namespace curvesfm

@@ -1,0 +1,103 @@
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/bezier.h"
+#include "core/camera.h"
+#include "core/nearest_edge_field.h"
+#include "core/pose3.h"
+#include "core/segment_observation.h"
+#include "factors/curve_reprojection_factor.h"
+#include "factors/pose_variables.h"
+#include "graph/factor_graph.h"
+#include "graph/optimizer.h"
+#include "graph/robust_kernel.h"
+#include "graph/values.h"
+
+namespace curvesfm {
+
+/// The paper's objective E = E_geo + lambda1 E_s1 + lambda2 E_s2 (§3.1) as graph weights.
+/// E_geo residuals are pixels, E_s1 residuals scene length units (metres), E_s2 residuals
+/// radians, so the lambdas carry units: lambda1 is px^2 per m^2 of length change, lambda2 px^2
+/// per rad^2. Each term becomes a noise model with sigma = 1 / sqrt(lambda).
+struct CurveBundleAdjustmentOptions {
+  /// s: each (segment, keyframe) pair gives s + 1 residuals at t_k = k / s. 1..64.
+  int samples_per_segment = 10;
+  /// Measure against the nearest edge pixel's sub-pixel position (true) or its pixel centre.
+  bool use_subpixel_edges = true;
+  /// Match a sample only to an edge whose normal lies within this angle (deg) of the projected
+  /// curve's normal (CurveSampling::max_normal_angle_deg); (0, 90], 90 accepts every match.
+  /// Lower values remove most of the bias of partly hidden curves but cap more samples of a
+  /// poor start (docs/benchmarks.md, "Curve bundle adjustment").
+  double max_normal_angle_deg = 90.0;
+  double pixel_sigma = 1.0;                            ///< Std dev of an edge residual (px); > 0.
+  RobustKernelType kernel = RobustKernelType::kHuber;  ///< Kernel on edge residuals.
+  double kernel_width = 2.0;  ///< Kernel width in sigmas (px at sigma 1); > 0.
+  double lambda1 = 100.0;     ///< Weight of E_s1, segment length (px^2 / m^2); >= 0, 0 drops it.
+  double lambda2 = 1.0;  ///< Weight of E_s2, tangent alignment (px^2 / rad^2); >= 0, 0 drops it.
+  bool fix_first_pose = true;  ///< Hold keyframe 0 constant (6 of the 7 gauge DoF).
+  /// Fix the scale through the distance between keyframes 0 and 1 (a CameraDistanceFactor at
+  /// CurveBundleAdjustmentInput::scale_distance). Needs at least 2 keyframes.
+  bool fix_scale = true;
+  double scale_sigma = 1e-4;  ///< Std dev of that distance constraint (scene units); > 0.
+  /// Tie the motion between consecutive keyframes to that of
+  /// CurveBundleAdjustmentInput::motion_prior_cam_from_world (a RelativePoseFactor per pair):
+  /// odometry drifts but is locally accurate, and it holds the pose directions that a scene
+  /// with edges in few directions leaves weakly constrained.
+  bool motion_prior = true;
+  /// Std dev of each pair's motion per axis: rotation (deg), and translation as a fraction of
+  /// the mean distance between consecutive camera centres of the prior trajectory, so that it
+  /// does not depend on the unit of the initial poses (a monocular start has none); > 0. The
+  /// defaults are `synth planar`'s drift per frame (0.05 deg, 1 mm of a 13.5 mm step) over 2.5:
+  /// the s + 1 samples of a segment share its error, so the edge term counts each segment
+  /// several times over, and a prior at the true sigma loses to wrong young curves (planar
+  /// bench: WindowsLogo 20 % ends at 3.5 mm from 2.2 mm with it, 1.9 mm with these;
+  /// docs/benchmarks.md).
+  double motion_prior_rotation_sigma_deg = 0.02;
+  double motion_prior_translation_sigma_rel = 0.03;
+
+  /// Throws InvalidOptions naming the field, its value and the constraint.
+  void validate() const;
+};
+
+/// A curve bundle adjustment as plain input data: one camera model shared by all keyframes.
+struct CurveBundleAdjustmentInput {
+  std::shared_ptr<const Camera> camera;
+  std::vector<Pose3> cam_from_world;                            ///< Starting guess per keyframe.
+  std::vector<std::shared_ptr<const NearestEdgeField>> fields;  ///< One per keyframe.
+  std::vector<PolyBezier> curves;  ///< Starting guess per curve, in world.
+  std::vector<SegmentObservation> observations;
+  /// Distance between the centres of keyframes 0 and 1 that fixes the scale; <= 0 keeps the
+  /// starting distance.
+  double scale_distance = 0.0;
+  /// The trajectory whose consecutive motions CurveBundleAdjustmentOptions::motion_prior keeps
+  /// (usually the initial poses); empty for none, else one pose per keyframe.
+  std::vector<Pose3> motion_prior_cam_from_world;
+};
+
+/// The graph, the starting values and what is held constant. Keys: poseKey(j) per keyframe,
+/// segmentKeys(c, i) per curve segment.
+struct CurveBundleAdjustmentProblem {
+  FactorGraph graph;
+  Values values;
+  ProblemConfig config;
+};
+
+/// One CurveReprojectionFactor per observation, one SegmentLengthFactor and one
+/// TangentAlignmentFactor per segment (when their lambda is > 0), the gauge, and a
+/// RelativePoseFactor per consecutive keyframe pair when the motion prior is on and given. Curve
+/// variables no observation touches stay in the values but get no factor. Throws CheckError for an
+/// observation out of range, a missing field, or fields that differ from the camera's size.
+CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
+    const CurveBundleAdjustmentInput& input, const CurveBundleAdjustmentOptions& options);
+
+/// The curves of `values`, with the segment counts of `layout` (usually the input curves).
+/// Lengths the optimiser drove to zero or below are floored at 1e-9 so that the result is a
+/// valid PolyBezier.
+std::vector<PolyBezier> extractCurves(const Values& values, const std::vector<PolyBezier>& layout);
+
+/// Where the samples of every curve reprojection factor of `graph` fall at `values`.
+CurveSampleCounts countCurveSamples(const FactorGraph& graph, const Values& values);
+
+}  // namespace curvesfm

@@ -1,0 +1,58 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/point_observation.h"
+#include "core/pose3.h"
+#include "factors/pose_variables.h"
+#include "graph/factor_graph.h"
+#include "graph/optimizer.h"
+#include "graph/robust_kernel.h"
+#include "graph/values.h"
+
+namespace curvesfm {
+
+/// Weights and gauge of a classic point bundle adjustment.
+struct PointBundleAdjustmentOptions {
+  double pixel_sigma = 1.0;  ///< Std dev of a pixel measurement (px); > 0.
+  RobustKernelType kernel = RobustKernelType::kHuber;  ///< Robust kernel on reprojection errors.
+  double kernel_width = 1.0;   ///< Kernel width in sigmas (i.e. pixels at sigma 1); > 0.
+  bool fix_first_pose = true;  ///< Hold camera 0 constant (6 of the 7 gauge DoF).
+  /// Fix the scale through the distance between cameras 0 and 1 (a CameraDistanceFactor at
+  /// PointBundleAdjustmentInput::scale_distance). Needs at least 2 cameras.
+  bool fix_scale = true;
+  double scale_sigma = 1e-4;  ///< Std dev of that distance constraint (scene units); > 0.
+
+  void validate() const;
+};
+
+/// A point bundle adjustment as plain input data: one camera model shared by all images.
+struct PointBundleAdjustmentInput {
+  std::shared_ptr<const Camera> camera;
+  std::vector<Pose3> cam_from_world;    ///< Starting guess per image.
+  std::vector<Eigen::Vector3d> points;  ///< Starting guess per point, in world.
+  std::vector<PointObservation> observations;
+  /// Distance between the centres of cameras 0 and 1 that fixes the scale; <= 0 keeps the
+  /// starting distance.
+  double scale_distance = 0.0;
+};
+
+/// The graph, the starting values (poseKey(i), pointKey(p)) and what is held constant.
+struct PointBundleAdjustmentProblem {
+  FactorGraph graph;
+  Values values;
+  ProblemConfig config;
+};
+
+/// Builds one PointReprojectionFactor per observation plus the gauge. Throws CheckError for an
+/// observation whose camera or point index is out of range.
+PointBundleAdjustmentProblem buildPointBundleAdjustment(
+    const PointBundleAdjustmentInput& input, const PointBundleAdjustmentOptions& options);
+
+/// The points of `values`, in input order (extractPoses gives the poses).
+std::vector<Eigen::Vector3d> extractPoints(const Values& values, std::size_t num_points);
+
+}  // namespace curvesfm

@@ -1,0 +1,607 @@
+#include "frontend/mapping/pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+
+#include "core/check.h"
+#include "core/errors.h"
+#include "core/nearest_edge_field.h"
+#include "factors/pose_variables.h"
+#include "frontend/mapping/keyframe_selector.h"
+
+namespace curvesfm {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// One keyframe as the later keyframes and bundle adjustment need it.
+struct Keyframe {
+  int frame_index = 0;
+  double timestamp = 0.0;
+  Pose3 initial_cam_from_world;
+  Pose3 cam_from_world;  // Current estimate.
+  cv::Mat image_bgr;     // Undistorted.
+  cv::Mat grey;          // Undistorted.
+  std::shared_ptr<const NearestEdgeField> field;
+};
+
+KeyframeView viewOf(const Keyframe& keyframe, const Camera& camera) {
+  return {keyframe.cam_from_world, camera, *keyframe.field, keyframe.image_bgr};
+}
+
+// The appearance and viewing direction of a segment seen in `keyframe`, as the map stores them.
+ObservedSegmentAppearance measureSegment(const BezierSegmentParams& segment, int keyframe_index,
+                                         const Keyframe& keyframe, const Camera& camera,
+                                         const CorrespondenceOptions& options) {
+  ObservedSegmentAppearance o;
+  o.observation.keyframe = keyframe_index;
+  o.appearance = appearanceOf(segment, keyframe.cam_from_world, camera, keyframe.image_bgr, options,
+                              keyframe.field.get());
+  o.viewing_direction_in_world =
+      viewingDirection(segment, keyframe.cam_from_world.inverseTranslation());
+  return o;
+}
+
+// What the map stores of a registration of segment `segment` of curve `id` in `keyframe`.
+ObservedSegmentAppearance registration(int id, int segment, int keyframe,
+                                       const CorrespondenceVerdict& verdict) {
+  return {{id, segment, keyframe}, verdict.appearance, verdict.viewing_direction_in_world};
+}
+
+// The projection of a segment as a polyline, or empty if part of it is behind the camera.
+std::vector<cv::Point> projectSegment(const BezierSegmentParams& segment,
+                                      const Pose3& cam_from_world, const Camera& camera,
+                                      int samples) {
+  const CubicBezier cubic = segment.toCubic();
+  std::vector<cv::Point> polyline;
+  for (int k = 0; k < samples; ++k) {
+    Eigen::Vector2d pixel;
+    const double t = static_cast<double>(k) / (samples - 1);
+    if (!camera.project(cam_from_world * cubic.evaluate(t), &pixel)) return {};
+    polyline.emplace_back(static_cast<int>(std::lround(pixel.x())),
+                          static_cast<int>(std::lround(pixel.y())));
+  }
+  return polyline;
+}
+
+// Fraction of the polyline's vertices that fall on non-zero pixels of `mask`.
+double fractionOnMask(const std::vector<cv::Point>& polyline, const cv::Mat& mask) {
+  if (polyline.empty()) return 0.0;
+  int on = 0;
+  for (const cv::Point& p : polyline) {
+    on += p.x >= 0 && p.y >= 0 && p.x < mask.cols && p.y < mask.rows && mask.at<uchar>(p) != 0;
+  }
+  return static_cast<double>(on) / polyline.size();
+}
+
+// The runs of chain pixels that no registered segment explains, as chains of their own.
+std::vector<EdgeChain> unexplainedRuns(const std::vector<EdgeChain>& chains,
+                                       const cv::Mat& explained, int min_length) {
+  std::vector<EdgeChain> runs;
+  for (const EdgeChain& chain : chains) {
+    EdgeChain run;
+    const auto flush = [&]() {
+      if (static_cast<int>(run.pixels.size()) >= min_length) runs.push_back(run);
+      run = EdgeChain();
+    };
+    for (std::size_t i = 0; i < chain.pixels.size(); ++i) {
+      const Eigen::Vector2i& p = chain.pixels[i];
+      if (explained.at<uchar>(p.y(), p.x()) != 0) {
+        flush();
+        continue;
+      }
+      run.pixels.push_back(p);
+      run.normals.push_back(chain.normals[i]);
+    }
+    flush();
+  }
+  return runs;
+}
+
+// The reference view that served most valid pixels in [first, last] of a chain; -1 if none.
+int dominantReference(const std::vector<PixelDepth>& depths, const PixelRange& range) {
+  std::map<int, int> votes;
+  for (int i = range.first; i <= range.last; ++i) {
+    if (depths[i].valid()) ++votes[depths[i].reference];
+  }
+  int best = -1;
+  int best_votes = 0;
+  for (const auto& [reference, count] : votes) {
+    if (count > best_votes) {
+      best = reference;
+      best_votes = count;
+    }
+  }
+  return best;
+}
+
+void countRejection(CorrespondenceCheck failed, KeyframeStats* stats) {
+  switch (failed) {
+    case CorrespondenceCheck::kDepth:
+      ++stats->rejected_depth;
+      break;
+    case CorrespondenceCheck::kEdgeDistance:
+      ++stats->rejected_edge_distance;
+      break;
+    case CorrespondenceCheck::kViewingDirection:
+      ++stats->rejected_viewing_direction;
+      break;
+    case CorrespondenceCheck::kAppearance:
+      ++stats->rejected_appearance;
+      break;
+    case CorrespondenceCheck::kNone:
+      break;
+  }
+}
+
+void requireDepthCandidates(int value) {
+  requireOption(value >= 1, "PipelineOptions", "depth_reference_candidates", value, ">= 1");
+}
+
+}  // namespace
+
+SchedulerOptions defaultLocalBundleAdjustmentOptions() {
+  SchedulerOptions options;
+  options.strategy = Strategy::kAlternating;
+  options.scope = Scope::kLocal;
+  options.local_window = 5;
+  return options;
+}
+
+void PipelineOptions::validate() const {
+  undistort.validate();
+  edges.validate();
+  chains.validate();
+  field.validate();
+  depth.validate();
+  initialiser.validate();
+  extension.validate();
+  correspondence.validate();
+  map.validate();
+  ba.validate();
+  local_ba.validate();
+  global_ba.validate();
+  tracking.validate();
+  requireDepthCandidates(depth_reference_candidates);
+  requireOption(reassociation_rounds >= 0, "PipelineOptions", "reassociation_rounds",
+                reassociation_rounds, ">= 0");
+  requireOption(std::isfinite(explained_radius_px) && explained_radius_px >= 0.0, "PipelineOptions",
+                "explained_radius_px", explained_radius_px, "must be finite and >= 0");
+}
+
+struct Pipeline::Impl {
+  Impl(const Camera& source_camera, const PipelineOptions& pipeline_options)
+      : options((pipeline_options.validate(), pipeline_options)),
+        undistorter(source_camera, options.undistort),
+        camera(std::make_shared<const Camera>(undistorter.camera())),
+        initialiser(options.initialiser),
+        selector(options.map),
+        map(options.map) {}
+
+  KeyframeStats addFrame(const PipelineFrame& frame);
+  cv::Mat prepareKeyframe(const PipelineFrame& frame, std::vector<EdgeChain>* chains,
+                          KeyframeStats* stats);
+  void trackPose(Keyframe* keyframe);
+  void registerTier(int k, CurveState state, bool skip_explained, cv::Mat* explained,
+                    KeyframeStats* stats);
+  void registerMap(int k, cv::Mat* explained, KeyframeStats* stats);
+  int reassociate();
+  std::vector<int> depthReferences(int k, const std::vector<EdgeChain>& chains) const;
+  void initialiseCurves(int k, const std::vector<EdgeChain>& chains, KeyframeStats* stats);
+  std::vector<OpenEnd> openEnds(int k) const;
+  void addInitialCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
+                       const std::vector<int>& reference_keyframes, std::vector<OpenEnd>* open_ends,
+                       KeyframeStats* stats);
+  void registerNewSegments(int k, int id, const std::vector<int>& segment_ids,
+                           const InitialCurve& initial, const ChainDepths& depths,
+                           const std::vector<int>& reference_keyframes);
+  CurveBundleAdjustmentInput bundleInput(CurveSelection selection, std::vector<int>* ids) const;
+  ScheduleReport bundleAdjust(CurveSelection selection, const SchedulerOptions& scheduler,
+                              bool refine_poses, CurveSampleCounts* samples);
+
+  PipelineOptions options;
+  ImageUndistorter undistorter;
+  std::shared_ptr<const Camera> camera;
+  CurveInitialiser initialiser;
+  KeyframeSelector selector;
+  CurveMap map;
+  std::vector<Keyframe> keyframes;
+  std::vector<KeyframeStats> frames;
+  bool finished = false;
+};
+
+cv::Mat Pipeline::Impl::prepareKeyframe(const PipelineFrame& frame, std::vector<EdgeChain>* chains,
+                                        KeyframeStats* stats) {
+  CURVESFM_CHECK(frame.image_bgr.type() == CV_8UC3)
+      << "frame " << stats->frame_index << ": expected a CV_8UC3 BGR image, found type "
+      << frame.image_bgr.type() << " (" << frame.image_bgr.channels() << " channels)";
+  Keyframe keyframe;
+  keyframe.frame_index = stats->frame_index;
+  keyframe.timestamp = frame.timestamp;
+  keyframe.initial_cam_from_world = frame.initial_cam_from_world;
+  keyframe.cam_from_world = frame.initial_cam_from_world;
+
+  Clock::time_point start = Clock::now();
+  keyframe.image_bgr = undistorter.undistort(frame.image_bgr).clone();
+  cv::cvtColor(keyframe.image_bgr, keyframe.grey, cv::COLOR_BGR2GRAY);
+  stats->undistort_seconds = secondsSince(start);
+
+  start = Clock::now();
+  const EdgeImage edges = detectEdges(keyframe.grey, options.edges, undistorter.validMask());
+  *chains = extractEdgeChains(edges, options.chains);
+  stats->edges_seconds = secondsSince(start);
+  stats->edge_pixels = cv::countNonZero(edges.edges);
+  stats->chains = static_cast<int>(chains->size());
+
+  start = Clock::now();
+  keyframe.field = std::make_shared<const NearestEdgeField>(
+      NearestEdgeField::build(edges.edges, edges.grad_x, edges.grad_y, options.field));
+  stats->field_seconds = secondsSince(start);
+  keyframes.push_back(std::move(keyframe));
+  return edges.edges;
+}
+
+void Pipeline::Impl::trackPose(Keyframe* keyframe) {
+  CurveBundleAdjustmentInput input;
+  input.camera = camera;
+  input.cam_from_world = {keyframe->cam_from_world};
+  input.fields = {keyframe->field};
+  // Global curves only: temporary ones come straight from depth and were never refined.
+  for (const int id : map.curvesIn(CurveState::kGlobal)) {
+    const PolyBezier& curve = map.curve(id).curve;
+    const int exported = static_cast<int>(input.curves.size());
+    input.curves.push_back(curve);
+    for (int i = 0; i < curve.numSegments(); ++i) {
+      if (checkPositiveDepth(curve.segment(i), keyframe->cam_from_world, options.correspondence)
+              .passed) {
+        input.observations.push_back({exported, i, 0});
+      }
+    }
+  }
+  if (input.observations.empty()) return;
+  CurveBundleAdjustmentOptions ba = options.ba;
+  ba.fix_first_pose = false;
+  ba.fix_scale = false;
+  ba.lambda1 = 0.0;
+  ba.lambda2 = 0.0;
+  CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
+  for (const VariableCategory c :
+       {VariableCategory::kCurvePoint, VariableCategory::kDirection, VariableCategory::kLength}) {
+    problem.config.setConstant(c);
+  }
+  const OptimizationSummary summary =
+      optimize(problem.graph, &problem.values, problem.config, options.tracking);
+  if (summary.usable) keyframe->cam_from_world = extractPoses(problem.values, 1)[0];
+}
+
+void Pipeline::Impl::registerTier(int k, CurveState state, bool skip_explained, cv::Mat* explained,
+                                  KeyframeStats* stats) {
+  const Keyframe& keyframe = keyframes[k];
+  const KeyframeView view = viewOf(keyframe, *camera);
+  const int samples = 2 * options.correspondence.samples_per_segment + 1;
+  const int thickness = 2 * static_cast<int>(std::ceil(options.explained_radius_px)) + 1;
+  std::vector<std::vector<cv::Point>> registered;
+  for (const int id : map.curvesIn(state)) {
+    const MapCurve& curve = map.curve(id);
+    for (int i = 0; i < curve.curve.numSegments(); ++i) {
+      const BezierSegmentParams segment = curve.curve.segment(i);
+      std::vector<cv::Point> polyline =
+          projectSegment(segment, keyframe.cam_from_world, *camera, samples);
+      // A lower tier must not take over edges a higher one explains: duplicates of a curve.
+      if (skip_explained && fractionOnMask(polyline, *explained) > 0.5) {
+        ++stats->rejected_duplicate;
+        continue;
+      }
+      const CorrespondenceVerdict verdict =
+          registerSegment(segment, view, curve.segments[i].history(), options.correspondence);
+      if (!verdict.registered) {
+        countRejection(verdict.failed_check, stats);
+        continue;
+      }
+      map.addObservation(id, i, registration(id, i, k, verdict));
+      ++stats->registered_segments;
+      if (!polyline.empty()) registered.push_back(std::move(polyline));
+    }
+  }
+  cv::polylines(*explained, registered, false, cv::Scalar(255), thickness);
+}
+
+void Pipeline::Impl::registerMap(int k, cv::Mat* explained, KeyframeStats* stats) {
+  // Global first, so that a temporary duplicate cannot claim edges a global curve explains
+  // (paper §3.3); disabled curves last, to notice when they are seen again.
+  registerTier(k, CurveState::kGlobal, false, explained, stats);
+  registerTier(k, CurveState::kTemporary, true, explained, stats);
+  registerTier(k, CurveState::kDisabled, true, explained, stats);
+}
+
+// Registers every promoted curve's segments in every keyframe that does not observe them yet,
+// with the same four checks, at the refined poses and curves. Returns the observations added.
+int Pipeline::Impl::reassociate() {
+  int added = 0;
+  std::vector<int> ids = map.curvesIn(CurveState::kGlobal);
+  for (const int id : map.curvesIn(CurveState::kDisabled)) {
+    if (map.curve(id).promoted) ids.push_back(id);
+  }
+  for (int k = 0; k < static_cast<int>(keyframes.size()); ++k) {
+    const KeyframeView view = viewOf(keyframes[k], *camera);
+    for (const int id : ids) {
+      const MapCurve& curve = map.curve(id);
+      for (int i = 0; i < curve.curve.numSegments(); ++i) {
+        if (curve.segments[i].observedIn(k)) continue;
+        const CorrespondenceVerdict verdict = registerSegment(
+            curve.curve.segment(i), view, curve.segments[i].history(), options.correspondence);
+        if (!verdict.registered) continue;
+        map.addObservation(id, i, registration(id, i, k, verdict));
+        ++added;
+      }
+    }
+  }
+  return added;
+}
+
+std::vector<int> Pipeline::Impl::depthReferences(int k,
+                                                 const std::vector<EdgeChain>& chains) const {
+  std::vector<int> candidates;
+  for (int j = k - 1; j >= 0 && j >= k - options.depth_reference_candidates; --j) {
+    candidates.push_back(j);
+  }
+  std::vector<Pose3> candidate_poses;
+  for (const int j : candidates) candidate_poses.push_back(keyframes[j].cam_from_world);
+  std::vector<int> references;
+  for (const ReferenceCandidate& c : rankReferenceFrames(
+           keyframes[k].cam_from_world, candidate_poses, *camera, chains, options.depth)) {
+    if (c.eligible) references.push_back(candidates[c.index]);
+  }
+  return references;
+}
+
+void Pipeline::Impl::initialiseCurves(int k, const std::vector<EdgeChain>& chains,
+                                      KeyframeStats* stats) {
+  if (k == 0 || chains.empty()) return;
+  Clock::time_point start = Clock::now();
+  const std::vector<int> reference_keyframes = depthReferences(k, chains);
+  std::vector<DepthReferenceView> references;
+  for (const int j : reference_keyframes) {
+    references.push_back({keyframes[j].grey, keyframes[j].cam_from_world});
+  }
+  const ChainDepths depths = estimateChainDepths(keyframes[k].grey, keyframes[k].cam_from_world,
+                                                 chains, references, *camera, options.depth);
+  stats->valid_depths = depths.counts.valid();
+  stats->depth_seconds = secondsSince(start);
+
+  start = Clock::now();
+  const CurveInitialisation initialisation =
+      initialiser.initialise(*camera, keyframes[k].cam_from_world, chains, depths);
+  std::vector<OpenEnd> open_ends = openEnds(k);
+  for (const InitialCurve& initial : initialisation.curves) {
+    addInitialCurve(k, initial, depths, reference_keyframes, &open_ends, stats);
+  }
+  stats->initialise_seconds = secondsSince(start);
+}
+
+// The ends of the curves whose end segment keyframe k registered: the edge pixels next to them
+// belong to the same chain, so a new curve lifted from there may continue the curve.
+std::vector<OpenEnd> Pipeline::Impl::openEnds(int k) const {
+  std::vector<OpenEnd> ends;
+  if (!options.extension.enabled) return ends;
+  for (int id = 0; id < map.size(); ++id) {
+    const MapCurve& c = map.curve(id);
+    for (const CurveEnd end : {CurveEnd::kFront, CurveEnd::kBack}) {
+      if (!c.segments[endSegment(c.curve, end)].observedIn(k)) continue;
+      const std::optional<OpenEnd> open =
+          openEnd(id, c.curve, end, keyframes[k].cam_from_world, *camera);
+      if (open) ends.push_back(*open);
+    }
+  }
+  return ends;
+}
+
+// Adds `initial` to the map: appended to the open end it continues smoothly (that end is then
+// used up), else as a curve of its own.
+void Pipeline::Impl::addInitialCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
+                                     const std::vector<int>& reference_keyframes,
+                                     std::vector<OpenEnd>* open_ends, KeyframeStats* stats) {
+  const std::optional<CurveJoin> join =
+      findJoin(initial.curve, *open_ends, keyframes[k].cam_from_world, *camera, options.extension);
+  if (!join) {
+    const int id = map.addCurve(initial.curve, k);
+    std::vector<int> segment_ids(initial.curve.numSegments());
+    std::iota(segment_ids.begin(), segment_ids.end(), 0);
+    registerNewSegments(k, id, segment_ids, initial, depths, reference_keyframes);
+    ++stats->new_curves;
+    return;
+  }
+  const OpenEnd open = (*open_ends)[join->open_end];
+  open_ends->erase(open_ends->begin() + join->open_end);
+  const ExtendedCurve extended =
+      extendCurve(map.curve(open.curve).curve, open.end, initial.curve, join->new_end);
+  map.extendCurve(open.curve, extended.curve, open.end);
+  registerNewSegments(k, open.curve, extended.added_segments, initial, depths, reference_keyframes);
+  ++stats->extended_curves;
+}
+
+// Registers in keyframe k, and in the reference view its depth came from, each segment i of
+// `initial`, which is segment segment_ids[i] of map curve `id`.
+void Pipeline::Impl::registerNewSegments(int k, int id, const std::vector<int>& segment_ids,
+                                         const InitialCurve& initial, const ChainDepths& depths,
+                                         const std::vector<int>& reference_keyframes) {
+  const std::vector<PixelDepth>& chain_depths = depths.chains[initial.chain];
+  for (std::size_t i = 0; i < segment_ids.size(); ++i) {
+    const int s = segment_ids[i];
+    const BezierSegmentParams segment = map.curve(id).curve.segment(s);
+    const ObservedSegmentAppearance here =
+        measureSegment(segment, k, keyframes[k], *camera, options.correspondence);
+    // The reference view saw the segment too (its depth came from there); verify it as any other
+    // registration, against what keyframe k measured.
+    const int reference = dominantReference(chain_depths, initial.segment_pixels[i]);
+    if (reference >= 0) {
+      const int j = reference_keyframes[reference];
+      SegmentHistory history;
+      history.reference_appearance = here.appearance;
+      history.mean_viewing_direction_in_world = here.viewing_direction_in_world;
+      const CorrespondenceVerdict verdict =
+          registerSegment(segment, viewOf(keyframes[j], *camera), history, options.correspondence);
+      if (verdict.registered) {
+        map.addObservation(id, s, registration(id, s, j, verdict));
+      }
+    }
+    map.addObservation(id, s, here);
+  }
+}
+
+CurveBundleAdjustmentInput Pipeline::Impl::bundleInput(CurveSelection selection,
+                                                       std::vector<int>* ids) const {
+  CurveBundleAdjustmentInput input;
+  input.camera = camera;
+  for (const Keyframe& keyframe : keyframes) {
+    input.cam_from_world.push_back(keyframe.cam_from_world);
+    input.motion_prior_cam_from_world.push_back(keyframe.initial_cam_from_world);
+    input.fields.push_back(keyframe.field);
+  }
+  // The scale gauge: the initial baseline of the first two keyframes, so the map keeps the unit
+  // of the initial poses.
+  input.scale_distance = cameraCentreDistance(keyframes[1].initial_cam_from_world,
+                                              keyframes[0].initial_cam_from_world);
+  ExportedCurves exported = map.exportCurves(selection);
+  input.curves = std::move(exported.curves);
+  input.observations = std::move(exported.observations);
+  *ids = std::move(exported.ids);
+  return input;
+}
+
+ScheduleReport Pipeline::Impl::bundleAdjust(CurveSelection selection,
+                                            const SchedulerOptions& scheduler, bool refine_poses,
+                                            CurveSampleCounts* samples) {
+  std::vector<int> ids;
+  const CurveBundleAdjustmentInput input = bundleInput(selection, &ids);
+  if (input.observations.empty()) return {};
+  CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options.ba);
+  if (!refine_poses) problem.config.setConstant(VariableCategory::kPose);
+  SchedulerOptions schedule = scheduler;
+  schedule.fix_first_pose = options.ba.fix_first_pose;
+  const ScheduleReport report =
+      runSchedule(problem.graph, &problem.values, problem.config, schedule);
+  const std::vector<Pose3> refined = extractPoses(problem.values, keyframes.size());
+  for (std::size_t j = 0; j < keyframes.size(); ++j) keyframes[j].cam_from_world = refined[j];
+  map.updateCurves(ids, extractCurves(problem.values, input.curves));
+  if (samples != nullptr) *samples = countCurveSamples(problem.graph, problem.values);
+  return report;
+}
+
+KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
+  CURVESFM_CHECK(!finished) << "Pipeline::addFrame after finish()";
+  KeyframeStats stats;
+  stats.frame_index = static_cast<int>(frames.size());
+  stats.timestamp = frame.timestamp;
+  if (!selector.isKeyframe(frame.initial_cam_from_world)) {
+    frames.push_back(stats);
+    return stats;
+  }
+  const int k = static_cast<int>(keyframes.size());
+  stats.keyframe_index = k;
+  std::vector<EdgeChain> chains;
+  const cv::Mat edges = prepareKeyframe(frame, &chains, &stats);
+
+  const Clock::time_point start = Clock::now();
+  if (options.track_keyframe_pose && k > 0) trackPose(&keyframes[k]);
+  cv::Mat explained = cv::Mat::zeros(edges.size(), CV_8UC1);
+  registerMap(k, &explained, &stats);
+  stats.correspondence_seconds = secondsSince(start);
+
+  initialiseCurves(k, unexplainedRuns(chains, explained, options.chains.min_length_px), &stats);
+  map.endKeyframe(k);
+
+  if (keyframes.size() >= 2 && map.count(CurveState::kGlobal) > 0) {
+    const ScheduleReport report = bundleAdjust(CurveSelection::kGlobal, options.local_ba,
+                                               options.local_ba_refines_poses, nullptr);
+    stats.local_ba_seconds = report.total_seconds;
+    stats.local_ba_initial_cost = report.initial_cost;
+    stats.local_ba_final_cost = report.final_cost;
+  }
+  stats.global_curves = map.count(CurveState::kGlobal);
+  stats.temporary_curves = map.count(CurveState::kTemporary);
+  frames.push_back(stats);
+  return stats;
+}
+
+KeyframeTimes keyframeTimes(const std::vector<KeyframeStats>& frames) {
+  KeyframeTimes t;
+  for (const KeyframeStats& s : frames) {
+    if (s.keyframe_index < 0) continue;
+    ++t.keyframes;
+    t.undistort_ms += s.undistort_seconds;
+    t.edges_ms += s.edges_seconds;
+    t.field_ms += s.field_seconds;
+    t.depth_ms += s.depth_seconds;
+    t.correspondence_ms += s.correspondence_seconds;
+    t.initialise_ms += s.initialise_seconds;
+    t.frontend_ms += s.frontendSeconds();
+    t.local_ba_ms += s.local_ba_seconds;
+    t.slowest_frontend_ms = std::max(t.slowest_frontend_ms, 1e3 * s.frontendSeconds());
+  }
+  const double ms_per_keyframe = t.keyframes == 0 ? 0.0 : 1e3 / t.keyframes;
+  for (double* v : {&t.undistort_ms, &t.edges_ms, &t.field_ms, &t.depth_ms, &t.correspondence_ms,
+                    &t.initialise_ms, &t.frontend_ms, &t.local_ba_ms}) {
+    *v *= ms_per_keyframe;
+  }
+  return t;
+}
+
+double PipelineResult::globalBaSeconds() const {
+  double seconds = global_ba.total_seconds;
+  for (const ReassociationRound& round : reassociation) seconds += round.global_ba.total_seconds;
+  return seconds;
+}
+
+Pipeline::Pipeline(const Camera& camera, const PipelineOptions& options)
+    : impl_(std::make_unique<Impl>(camera, options)) {}
+
+Pipeline::~Pipeline() = default;
+
+KeyframeStats Pipeline::addFrame(const PipelineFrame& frame) { return impl_->addFrame(frame); }
+
+PipelineResult Pipeline::finish() {
+  Impl& impl = *impl_;
+  CURVESFM_CHECK(!impl.finished) << "Pipeline::finish called twice";
+  impl.finished = true;
+  PipelineResult result;
+  if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
+    result.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
+                                         /*refine_poses=*/true, &result.final_samples);
+    for (int r = 0; r < impl.options.reassociation_rounds; ++r) {
+      ReassociationRound round;
+      round.added_observations = impl.reassociate();
+      if (round.added_observations == 0) break;
+      round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
+                                          /*refine_poses=*/true, &result.final_samples);
+      result.reassociation.push_back(std::move(round));
+    }
+  }
+  for (const Keyframe& keyframe : impl.keyframes) {
+    result.keyframe_timestamps.push_back(keyframe.timestamp);
+    result.keyframe_cam_from_world.push_back(keyframe.cam_from_world);
+    result.keyframe_initial_cam_from_world.push_back(keyframe.initial_cam_from_world);
+  }
+  result.curves = impl.map.exportCurves(CurveSelection::kPromoted).curves;
+  result.frames = impl.frames;
+  return result;
+}
+
+const Camera& Pipeline::undistortedCamera() const { return *impl_->camera; }
+
+const cv::Mat& Pipeline::keyframeImage(int k) const {
+  CURVESFM_CHECK(k >= 0 && k < static_cast<int>(impl_->keyframes.size()))
+      << "keyframe " << k << " out of range (" << impl_->keyframes.size() << " keyframes)";
+  return impl_->keyframes[k].image_bgr;
+}
+
+}  // namespace curvesfm

@@ -1,0 +1,124 @@
+// Curve bundle adjustments solved to the end on synthetic scenes (ctest label "slow").
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "core/errors.h"
+#include "factors/curve_bundle_adjustment.h"
+#include "graph/scheduler.h"
+#include "sim/curve_scene.h"
+#include "sim/curve_scene_input.h"
+
+namespace curvesfm {
+namespace {
+
+struct Solved {
+  CurveSceneErrors before;
+  CurveSceneErrors after;
+  ScheduleReport report;
+};
+
+Solved solve(const CurveScene& scene, Strategy strategy,
+             const CurveBundleAdjustmentOptions& ba = {}) {
+  const CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
+  SchedulerOptions scheduler;
+  scheduler.strategy = strategy;
+  scheduler.optimizer.max_iterations = 100;
+  Solved solved;
+  solved.before = evaluateCurveScene(scene, input.cam_from_world, input.curves);
+  solved.report = runSchedule(problem.graph, &problem.values, problem.config, scheduler);
+  solved.after =
+      evaluateCurveScene(scene, extractPoses(problem.values, input.cam_from_world.size()),
+                         extractCurves(problem.values, input.curves));
+  return solved;
+}
+
+// The issue's protocol: poses perturbed by ~2 cm / 1 deg, curves by ~2 cm, noise-free images.
+CurveSceneOptions perturbedScene() { return CurveSceneOptions{}; }
+
+TEST(CurveBundleAdjustment, JointRecoversPosesAndCurvesFromAPerturbedStart) {
+  const Solved solved = solve(makeCurveScene(perturbedScene()), Strategy::kJoint);
+  // Measured (seed 42): ATE 30 -> 2.8 mm, rotation 1.71 -> 0.065 deg, aligned curve error
+  // 27.5 -> 10.0 mm with the parabola sub-pixel fit; ATE 4.6 mm with the Gaussian fit now in
+  // NearestEdgeField. The result is sensitive to such details (docs/benchmarks.md, "Curve bundle
+  // adjustment"), hence the loose bounds. The curve figure is the weak one: a straight line can
+  // slide along itself, which the edge residual does not see.
+  EXPECT_LT(solved.after.position_ate_sim3, 0.25 * solved.before.position_ate_sim3);
+  EXPECT_LT(solved.after.rotation_mean_deg, 0.1 * solved.before.rotation_mean_deg);
+  EXPECT_LT(solved.after.curve_mean_error_aligned, 0.5 * solved.before.curve_mean_error_aligned);
+  EXPECT_LT(solved.report.final_cost, 0.1 * solved.report.initial_cost);
+}
+
+TEST(CurveBundleAdjustment, AlternatingReachesTheCostOfJointAndImprovesAsMuch) {
+  const CurveScene scene = makeCurveScene(perturbedScene());
+  const Solved joint = solve(scene, Strategy::kJoint);
+  const Solved alternating = solve(scene, Strategy::kAlternating);
+  // Both are local minima of the same objective; alternating's is not worse. Measured: cost
+  // 17663 -> 813 (joint), -> 78 (alternating); its poses stall in the flat valley of a global
+  // rotation about the fixed keyframe (rotation error 0.23 deg vs joint's 0.065 deg).
+  EXPECT_LE(alternating.report.final_cost, 1.05 * joint.report.final_cost);
+  EXPECT_LT(alternating.after.position_ate_sim3, 0.3 * alternating.before.position_ate_sim3);
+  EXPECT_LT(alternating.after.rotation_mean_deg, 0.2 * alternating.before.rotation_mean_deg);
+  EXPECT_LT(alternating.after.curve_mean_error_aligned,
+            0.5 * alternating.before.curve_mean_error_aligned);
+  // Each round may only lower the cost.
+  double previous = alternating.report.initial_cost;
+  for (const ScheduleRound& round : alternating.report.rounds) {
+    if (round.skipped) continue;
+    EXPECT_LE(round.summary.final_cost, previous * (1 + 1e-9)) << round.phase << round.round;
+    previous = round.summary.final_cost;
+  }
+}
+
+TEST(CurveBundleAdjustment, PartlyHiddenCurvesAreNotBiasedWithTheOrientationCheck) {
+  // Start at the truth with a contiguous 30-50% of a curve hidden in half of the (curve,
+  // keyframe) pairs. Hidden samples within the reach of the visible end match that end, where
+  // the gradient runs along the curve and pulls them towards the visible part. Measured
+  // (seed 42): aligned curve error 7.5 mm, ATE 4.9 mm with every match accepted; 0.8 mm /
+  // 1.6 mm with matches limited to edges within 20 deg of the curve normal; 1.4 mm / 1.1 mm
+  // with nothing hidden.
+  CurveSceneOptions options;
+  options.pose_noise_translation = 0.0;
+  options.pose_noise_rotation_deg = 0.0;
+  options.curve_point_noise = 0.0;
+  options.curve_tangent_noise_deg = 0.0;
+  options.curve_length_noise = 0.0;
+  options.occlusion_fraction = 0.5;
+  const CurveScene scene = makeCurveScene(options);
+  int partly_hidden = 0;
+  for (const CurveObservation& obs : scene.observations) partly_hidden += obs.partlyHidden();
+  ASSERT_GT(partly_hidden, static_cast<int>(scene.observations.size()) / 8);
+
+  const Solved unchecked = solve(scene, Strategy::kJoint);
+  CurveBundleAdjustmentOptions ba;
+  ba.max_normal_angle_deg = 20.0;
+  const Solved checked = solve(scene, Strategy::kJoint, ba);
+  EXPECT_LT(checked.after.curve_mean_error_aligned, 0.002);
+  EXPECT_LT(checked.after.position_ate_sim3, 0.003);
+  EXPECT_LT(checked.after.curve_mean_error_aligned, 0.3 * unchecked.after.curve_mean_error_aligned);
+}
+
+TEST(CurveBundleAdjustment, ATightMotionPriorKeepsThePriorsRelativeMotions) {
+  const CurveScene scene = makeCurveScene(perturbedScene());
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  input.motion_prior_cam_from_world = scene.true_cam_from_world;
+  CurveBundleAdjustmentOptions ba;
+  ba.motion_prior_rotation_sigma_deg = 1e-4;
+  ba.motion_prior_translation_sigma_rel = 1e-6;
+  CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
+  SchedulerOptions scheduler;
+  scheduler.optimizer.max_iterations = 100;
+  runSchedule(problem.graph, &problem.values, problem.config, scheduler);
+  const std::vector<Pose3> poses = extractPoses(problem.values, input.cam_from_world.size());
+  for (std::size_t j = 1; j < poses.size(); ++j) {
+    const Pose3 motion = poses[j] * poses[j - 1].inverse();
+    const Pose3 truth = scene.true_cam_from_world[j] * scene.true_cam_from_world[j - 1].inverse();
+    // The start is ~2 cm / 1 deg off per pose; the prior pins each motion to ~1e-6.
+    EXPECT_LT(truth.localCoordinates(motion).norm(), 1e-4) << "keyframes " << j - 1 << ", " << j;
+  }
+}
+
+}  // namespace
+}  // namespace curvesfm

@@ -1,0 +1,120 @@
+#include "factors/curve_bundle_adjustment.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "core/errors.h"
+#include "graph/scheduler.h"
+#include "sim/curve_scene.h"
+#include "sim/curve_scene_input.h"
+
+namespace curvesfm {
+namespace {
+
+int countFactors(const FactorGraph& graph, const std::string& type) {
+  int count = 0;
+  for (const auto& factor : graph) count += factor->typeName() == type;
+  return count;
+}
+
+TEST(CurveBundleAdjustment, MotionPriorTiesEachConsecutivePairOnlyWhenOnAndGiven) {
+  CurveSceneOptions scene_options;
+  scene_options.num_keyframes = 4;
+  const CurveScene scene = makeCurveScene(scene_options);
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, {}).graph, "relative_pose"), 0);
+  input.motion_prior_cam_from_world = scene.true_cam_from_world;
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, {}).graph, "relative_pose"), 3);
+  CurveBundleAdjustmentOptions off;
+  off.motion_prior = false;
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, off).graph, "relative_pose"), 0);
+  input.motion_prior_cam_from_world.pop_back();
+  EXPECT_THROW(buildCurveBundleAdjustment(input, {}), CheckError);
+}
+
+// The motion prior's cost when keyframe 2 of a trajectory scaled by `scale` is moved by
+// scale * 1 mm off it.
+double motionPriorCost(const CurveScene& scene, double scale) {
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  for (std::size_t j = 0; j < input.cam_from_world.size(); ++j) {
+    const Pose3& truth = scene.true_cam_from_world[j];
+    input.motion_prior_cam_from_world.push_back(
+        Pose3(truth.rotation(), scale * truth.translation()));
+    input.cam_from_world[j] = input.motion_prior_cam_from_world[j];
+  }
+  input.cam_from_world[2] =
+      input.cam_from_world[2].retract((Vector6d() << 0, 0, 0, scale * 1e-3, 0, 0).finished());
+  const CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, {});
+  return problem.graph.costByType(problem.values).at("relative_pose").cost;
+}
+
+TEST(CurveBundleAdjustment, MotionPriorTranslationSigmaFollowsTheUnitOfThePoses) {
+  const CurveScene scene = makeCurveScene(CurveSceneOptions{});
+  const double cost = motionPriorCost(scene, 1.0);
+  EXPECT_GT(cost, 0.0);
+  EXPECT_NEAR(motionPriorCost(scene, 10.0), cost, 1e-9 * cost);
+}
+
+TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
+  const auto expectRejected = [](CurveBundleAdjustmentOptions options, const std::string& field) {
+    try {
+      options.validate();
+      ADD_FAILURE() << field << " accepted";
+    } catch (const InvalidOptions& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  CurveBundleAdjustmentOptions options;
+  EXPECT_NO_THROW(options.validate());
+  options.samples_per_segment = 0;
+  expectRejected(options, "samples_per_segment");
+  options = {};
+  options.samples_per_segment = CurveReprojectionFactor::kMaxSamples;
+  expectRejected(options, "samples_per_segment");
+  options = {};
+  options.lambda1 = -1.0;
+  expectRejected(options, "lambda1");
+  options = {};
+  options.max_normal_angle_deg = 0.0;
+  expectRejected(options, "max_normal_angle_deg");
+  options.max_normal_angle_deg = 120.0;
+  expectRejected(options, "max_normal_angle_deg");
+  options = {};
+  options.lambda2 = std::nan("");
+  expectRejected(options, "lambda2");
+  options = {};
+  options.kernel_width = 0.0;
+  expectRejected(options, "kernel_width");
+  options = {};
+  options.pixel_sigma = -1.0;
+  expectRejected(options, "pixel_sigma");
+  options = {};
+  options.motion_prior_rotation_sigma_deg = 0.0;
+  expectRejected(options, "motion_prior_rotation_sigma_deg");
+  options = {};
+  options.motion_prior_translation_sigma_rel = std::nan("");
+  expectRejected(options, "motion_prior_translation_sigma_rel");
+}
+
+TEST(CurveBundleAdjustment, RejectsMismatchedFieldsAndObservationsOutOfRange) {
+  CurveSceneOptions options;
+  options.num_keyframes = 3;
+  options.num_curves = 2;
+  const CurveScene scene = makeCurveScene(options);
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  CurveBundleAdjustmentInput missing_field = input;
+  missing_field.fields.pop_back();
+  EXPECT_THROW(buildCurveBundleAdjustment(missing_field, {}), CheckError);
+  CurveBundleAdjustmentInput bad_observation = input;
+  bad_observation.observations.push_back({0, scene.true_curves[0].numSegments(), 0});
+  EXPECT_THROW(buildCurveBundleAdjustment(bad_observation, {}), CheckError);
+  CurveBundleAdjustmentInput wrong_size = input;
+  wrong_size.fields[1] = std::make_shared<const NearestEdgeField>();
+  EXPECT_THROW(buildCurveBundleAdjustment(wrong_size, {}), CheckError);
+  EXPECT_NO_THROW(buildCurveBundleAdjustment(input, {}));
+}
+
+}  // namespace
+}  // namespace curvesfm

@@ -1,0 +1,98 @@
+#include "factors/point_bundle_adjustment.h"
+
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+#include "sim/point_scene.h"
+
+namespace curvesfm {
+namespace {
+
+PointSceneOptions smallScene(double pixel_noise) {
+  PointSceneOptions options;
+  options.num_cameras = 12;
+  options.num_points = 300;
+  options.track_length = 6;
+  options.pixel_noise = pixel_noise;
+  options.seed = 7;
+  return options;
+}
+
+struct Solved {
+  PointSceneErrors before;
+  PointSceneErrors after;
+  OptimizationSummary summary;
+};
+
+Solved solve(const PointScene& scene, OptimizerOptions optimizer = OptimizerOptions()) {
+  PointBundleAdjustmentProblem problem =
+      buildPointBundleAdjustment({scene.camera, scene.initial_cam_from_world, scene.initial_points,
+                                  scene.observations, scene.trueScaleDistance()},
+                                 PointBundleAdjustmentOptions());
+  Solved solved;
+  solved.before = evaluatePointScene(scene, scene.initial_cam_from_world, scene.initial_points);
+  solved.summary = optimize(problem.graph, &problem.values, problem.config, optimizer);
+  solved.after =
+      evaluatePointScene(scene, extractPoses(problem.values, scene.true_cam_from_world.size()),
+                         extractPoints(problem.values, scene.true_points.size()));
+  return solved;
+}
+
+TEST(PointBundleAdjustment, RecoversGroundTruthFromNoiseFreePixels) {
+  const PointScene scene = makePointScene(smallScene(0.0));
+  OptimizerOptions optimizer;
+  optimizer.function_tolerance = 1e-14;
+  optimizer.parameter_tolerance = 1e-14;
+  optimizer.gradient_tolerance = 1e-14;
+  optimizer.max_iterations = 100;
+  const Solved solved = solve(scene, optimizer);
+  EXPECT_TRUE(solved.summary.usable) << solved.summary.message;
+  EXPECT_GT(solved.before.position_rmse, 0.01);
+  EXPECT_LT(solved.after.position_rmse, 1e-7);
+  EXPECT_LT(solved.after.position_ate_sim3, 1e-7);
+  EXPECT_LT(solved.after.rotation_mean_deg, 1e-6);
+  EXPECT_LT(solved.after.point_rmse, 1e-7);
+  EXPECT_LT(solved.after.reprojection_rmse_px, 1e-6);
+}
+
+TEST(PointBundleAdjustment, ConvergesToTheNoiseLevel) {
+  const double sigma = 0.5;
+  const PointScene scene = makePointScene(smallScene(sigma));
+  const Solved solved = solve(scene);
+  EXPECT_TRUE(solved.summary.usable) << solved.summary.message;
+  // 2-D pixel noise: rms |residual| ~ sigma * sqrt(2) less the DoF the fit absorbs.
+  EXPECT_LT(solved.after.reprojection_rmse_px, sigma * std::sqrt(2.0));
+  EXPECT_GT(solved.after.reprojection_rmse_px, 0.6 * sigma * std::sqrt(2.0));
+  // In the fixed gauge, errors drift along the chain of cameras; the trajectory's shape (ATE
+  // after Sim(3) alignment) and the rotations are what the observations pin down.
+  EXPECT_LT(solved.after.position_ate_sim3, 0.25 * solved.before.position_ate_sim3);
+  EXPECT_LT(solved.after.rotation_mean_deg, 0.2 * solved.before.rotation_mean_deg);
+}
+
+TEST(PointBundleAdjustment, HoldsTheGauge) {
+  const PointScene scene = makePointScene(smallScene(0.5));
+  PointBundleAdjustmentProblem problem =
+      buildPointBundleAdjustment({scene.camera, scene.initial_cam_from_world, scene.initial_points,
+                                  scene.observations, scene.trueScaleDistance()},
+                                 PointBundleAdjustmentOptions());
+  EXPECT_TRUE(problem.config.isConstant(poseKey(0)));
+  optimize(problem.graph, &problem.values, problem.config, OptimizerOptions());
+  const auto poses = extractPoses(problem.values, 2);
+  EXPECT_EQ(poses[0].translation(), scene.initial_cam_from_world[0].translation());
+  EXPECT_NEAR((poses[1].inverseTranslation() - poses[0].inverseTranslation()).norm(),
+              scene.trueScaleDistance(), 1e-3);
+}
+
+TEST(PointBundleAdjustment, RejectsOutOfRangeObservationsAndBadOptions) {
+  const PointScene scene = makePointScene(smallScene(0.5));
+  PointBundleAdjustmentInput input{scene.camera, scene.initial_cam_from_world, scene.initial_points,
+                                   scene.observations, 0.0};
+  input.observations.push_back({99, 0, Eigen::Vector2d(1, 1)});
+  EXPECT_THROW(buildPointBundleAdjustment(input, PointBundleAdjustmentOptions()), CheckError);
+  PointBundleAdjustmentOptions bad;
+  bad.pixel_sigma = 0.0;
+  EXPECT_THROW(bad.validate(), InvalidOptions);
+}
+
+}  // namespace
+}  // namespace curvesfm

@@ -1,0 +1,149 @@
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <utility>
+
+#include "core/errors.h"
+#include "core/trajectory_evaluation.h"
+#include "frontend/mapping/pipeline.h"
+#include "sim/planar_scene.h"
+
+namespace curvesfm {
+namespace {
+
+// Random filled rectangles, circles and thick lines in random colours on a grey ground: strong,
+// partly curved edges of every orientation, so that the test runs without OpenCV's sample photos.
+cv::Mat syntheticTexture() {
+  cv::Mat texture(480, 640, CV_8UC3, cv::Scalar(128, 128, 128));
+  cv::RNG rng(7);
+  const auto colour = [&]() {
+    return cv::Scalar(rng.uniform(0, 256), rng.uniform(0, 256), rng.uniform(0, 256));
+  };
+  for (int i = 0; i < 25; ++i) {
+    const cv::Point a(rng.uniform(0, 640), rng.uniform(0, 480));
+    const cv::Point b(a.x + rng.uniform(30, 160), a.y + rng.uniform(30, 120));
+    cv::rectangle(texture, a, b, colour(), cv::FILLED);
+  }
+  for (int i = 0; i < 20; ++i) {
+    cv::circle(texture, {rng.uniform(0, 640), rng.uniform(0, 480)}, rng.uniform(10, 70), colour(),
+               cv::FILLED, cv::LINE_AA);
+  }
+  for (int i = 0; i < 15; ++i) {
+    cv::line(texture, {rng.uniform(0, 640), rng.uniform(0, 480)},
+             {rng.uniform(0, 640), rng.uniform(0, 480)}, colour(), rng.uniform(3, 8), cv::LINE_AA);
+  }
+  return texture;
+}
+
+// OpenCV's graffiti photo if installed (real texture), else the synthetic one.
+cv::Mat planarTexture() {
+  const std::string photo = "/usr/share/doc/opencv-doc/examples/data/graf1.png";
+  if (std::filesystem::exists(photo)) {
+    cv::Mat image = cv::imread(photo, cv::IMREAD_COLOR);
+    if (!image.empty()) return image;
+  }
+  return syntheticTexture();
+}
+
+// A short, small version of `curvesfm synth planar`'s orbit: the same geometry at 320 x 240,
+// neighbours 2 frame spacings of the default apart so that 8 frames still span a useful arc.
+PlanarSceneOptions smallOrbit() {
+  PlanarSceneOptions options;
+  options.num_frames = 8;
+  options.arc_degrees = 90.0 * 2 * 7 / 29;
+  options.width = 320;
+  options.height = 240;
+  options.fx = options.fy = 262.5;
+  options.cx = 159.5;
+  options.cy = 119.5;
+  options.intensity_noise = 0.01;  // The initial poses drift as synth planar's default.
+  options.seed = 3;
+  return options;
+}
+
+TEST(Pipeline, RefinesAPerturbedPlanarTrajectory) {
+  const PlanarScene scene = makePlanarScene(planarTexture(), smallOrbit());
+  PipelineOptions options;
+  options.map.min_keyframe_translation = 0.0;
+  options.map.min_keyframe_rotation_deg = 0.0;
+  Pipeline pipeline(*scene.camera, options);
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    const KeyframeStats stats =
+        pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
+    EXPECT_EQ(stats.keyframe_index, static_cast<int>(i));
+  }
+  const PipelineResult result = pipeline.finish();
+  ASSERT_EQ(result.keyframe_cam_from_world.size(), scene.images.size());
+  EXPECT_GT(result.curves.size(), 10u);
+  const double initial_ate =
+      evaluateTrajectory(scene.true_cam_from_world, scene.initial_cam_from_world).position_ate_sim3;
+  const double refined_ate =
+      evaluateTrajectory(scene.true_cam_from_world, result.keyframe_cam_from_world)
+          .position_ate_sim3;
+  // Bundle adjustment and re-association must leave the trajectory clearly closer to the truth
+  // than the drifting start.
+  EXPECT_LT(refined_ate, 0.5 * initial_ate)
+      << "initial ATE " << initial_ate << " m, refined " << refined_ate << " m";
+}
+
+// The first five frames of the small orbit, every one a keyframe, without global BA: curves are
+// global from keyframe 2 on, so local BA runs from there.
+PipelineResult runFiveFramesWithoutGlobalBa(PipelineOptions options) {
+  PlanarSceneOptions orbit = smallOrbit();
+  orbit.num_frames = 5;
+  const PlanarScene scene = makePlanarScene(planarTexture(), orbit);
+  options.map.min_keyframe_translation = 0.0;
+  options.map.min_keyframe_rotation_deg = 0.0;
+  options.run_global_ba = false;
+  Pipeline pipeline(*scene.camera, options);
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
+  }
+  return pipeline.finish();
+}
+
+// The largest camera-centre distance between the keyframe poses of that run and the starting
+// poses.
+double largestMoveWithoutGlobalBa(bool local_ba_refines_poses) {
+  PipelineOptions options;
+  options.local_ba_refines_poses = local_ba_refines_poses;
+  const PipelineResult result = runFiveFramesWithoutGlobalBa(options);
+  double largest = 0.0;
+  for (std::size_t j = 0; j < result.keyframe_cam_from_world.size(); ++j) {
+    largest = std::max(largest, cameraCentreDistance(result.keyframe_cam_from_world[j],
+                                                     result.keyframe_initial_cam_from_world[j]));
+  }
+  return largest;
+}
+
+TEST(Pipeline, LocalBaMovesPosesOnlyWhenAskedTo) {
+  EXPECT_EQ(largestMoveWithoutGlobalBa(false), 0.0);
+  EXPECT_GT(largestMoveWithoutGlobalBa(true), 1e-5);
+}
+
+// As the orbit turns, edges run on past the ends of the curves registered in each new keyframe;
+// those pieces extend the curves instead of starting new ones, unless extension is off.
+TEST(Pipeline, ExtendsCurvesThatNewEdgesContinue) {
+  const auto count = [](bool enabled) {
+    PipelineOptions options;
+    options.extension.enabled = enabled;
+    int started = 0, extended = 0;
+    for (const KeyframeStats& s : runFiveFramesWithoutGlobalBa(options).frames) {
+      started += s.new_curves;
+      extended += s.extended_curves;
+    }
+    return std::make_pair(started, extended);
+  };
+  const auto [started_with, extended_with] = count(true);
+  const auto [started_without, extended_without] = count(false);
+  EXPECT_GT(extended_with, 0);
+  EXPECT_EQ(extended_without, 0);
+  EXPECT_LT(started_with, started_without);
+}
+
+}  // namespace
+}  // namespace curvesfm

@@ -1,0 +1,26 @@
+#include "frontend/mapping/pipeline.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+
+namespace curvesfm {
+namespace {
+
+TEST(PipelineOptions, ValidateNamesTheStageAndField) {
+  PipelineOptions options;
+  options.depth_reference_candidates = 0;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<InvalidOptions>(
+                  testing::HasSubstr("PipelineOptions.depth_reference_candidates")));
+  options = {};
+  options.map.promotion_observations = 0;
+  EXPECT_THROW(options.validate(), InvalidOptions);
+  EXPECT_EQ(PipelineOptions{}.local_ba.strategy, Strategy::kAlternating);
+  EXPECT_EQ(PipelineOptions{}.local_ba.scope, Scope::kLocal);
+  EXPECT_FALSE(PipelineOptions{}.local_ba_refines_poses);
+}
+
+}  // namespace
+}  // namespace curvesfm

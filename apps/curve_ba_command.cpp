@@ -16,11 +16,10 @@ namespace {
 void addSceneFlags(CLI::App* c, CurveSceneOptions* scene) {
   c->add_option("--keyframes", scene->num_keyframes, "Keyframes (rendered images)")
       ->capture_default_str();
-  addEnumFlag(c, "camera-path", &scene->camera_path, parseCameraPath,
+  addEnumFlag(c, "camera-path", &scene->camera_path,
               "Where the keyframes are: orbit, forward_walk");
   c->add_option("--curves", scene->num_curves, "3D curves in the room")->capture_default_str();
-  addEnumFlag(c, "curve-kind", &scene->curve_kind, parseCurveKind,
-              "Shape of the curves: line, arc, helix, mixed");
+  addEnumFlag(c, "curve-kind", &scene->curve_kind, "Shape of the curves: line, arc, helix, mixed");
   c->add_option("--segments-per-curve", scene->segments_per_curve, "Cubic segments per curve")
       ->capture_default_str();
   c->add_option("--image-noise", scene->pixel_noise,

@@ -103,7 +103,8 @@ EvalCommand::EvalCommand(CLI::App* app) {
   c->add_option_function<std::string>(
        "--align",
        [this](const std::string& name) {
-         options_.alignment = parseAlignmentKind(name, "TrajectoryEvaluationOptions", "alignment");
+         options_.alignment =
+             parseEnumName<AlignmentKind>(name, "TrajectoryEvaluationOptions", "alignment");
        },
        "Alignment of the estimate onto the ground truth: sim3 (monocular), se3 (metric), none")
       ->default_str(toString(options_.alignment));

@@ -1,7 +1,6 @@
 #include "apps/run_command.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +14,7 @@
 #include "apps/cli/config_file.h"
 #include "apps/cli/pipeline_flags.h"
 #include "apps/cli/report_json.h"
+#include "core/clock.h"
 #include "core/curve_export.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
@@ -25,7 +25,6 @@ namespace curvesfm {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 nlohmann::json overlayOptionsToJson(const CurveOverlayOptions& o) {
   return {{"samples_per_segment", o.samples_per_segment},
@@ -39,10 +38,6 @@ std::string joinPath(const std::string& dir, const std::string& name) {
 
 // ---------------------------------------------------------------------------------------------
 // Run.
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 void printProgress(const KeyframeStats& s, int frames) {
   std::printf(

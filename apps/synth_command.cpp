@@ -71,7 +71,7 @@ SynthCommand::SynthCommand(CLI::App* app) {
       ->capture_default_str();
   c->add_option("--seed", options_.seed, "Random seed of the noise and the initial poses")
       ->capture_default_str();
-  addEnumFlag(c, "init-noise-model", &options_.init_noise_model, parseInitNoiseModel,
+  addEnumFlag(c, "init-noise-model", &options_.init_noise_model,
               "Initial poses: independent (every pose perturbed on its own) or drift (every "
               "motion between consecutive frames perturbed, errors accumulate as in visual "
               "odometry)");

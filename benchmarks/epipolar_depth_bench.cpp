@@ -161,8 +161,7 @@ void runCase(const Keyframe& key, int pixel_step, const std::string& name,
   print("median_relative_error_" + suffix, medianRelativeError(key, depths));
   for (int s = 1; s < kNumDepthStatuses; ++s) {
     const DepthStatus status = static_cast<DepthStatus>(s);
-    bench::printInt("rejected_" + std::string(depthStatusName(status)) + "_" + suffix,
-                    depths.counts.count(status));
+    bench::printInt("rejected_" + toString(status) + "_" + suffix, depths.counts.count(status));
   }
   std::fflush(stdout);
 }

@@ -557,7 +557,8 @@ int main(int argc, char** argv) {
   app.add_option_function<std::string>(
          "--init-noise-model",
          [&options](const std::string& name) {
-           options.init_noise_model = curvesfm::parseInitNoiseModel(name, "init_noise_model");
+           options.init_noise_model = curvesfm::parseEnumName<curvesfm::InitNoiseModel>(
+               name, "PlanarSceneOptions", "init_noise_model");
          },
          "Initial pose error: drift (per step, accumulating) or independent (per pose)")
       ->check(CLI::IsMember({"drift", "independent"}))

@@ -242,7 +242,8 @@ SchedulerOptions fixedIterationSolve(const BenchOptions& options) {
   SchedulerOptions scheduler;
   scheduler.strategy = Strategy::kJoint;
   OptimizerOptions& optimizer = scheduler.optimizer;
-  optimizer.linear_solver = parseLinearSolver(options.linear_solver, "--linear-solver");
+  optimizer.linear_solver =
+      parseEnumName<LinearSolver>(options.linear_solver, "OptimizerOptions", "linear_solver");
   optimizer.max_iterations = options.iterations;
   optimizer.num_threads = options.threads;
   optimizer.function_tolerance = 1e-300;

@@ -21,25 +21,6 @@ constexpr int kMaxStepHalvings = 10;
 // fixed-point step xn <- xn - (distort(xn) - xd), which is J ~= I.
 constexpr double kMinJacobianDeterminant = 1e-12;
 
-std::string toString(double value) {
-  std::ostringstream out;
-  out.imbue(std::locale::classic());
-  out << std::setprecision(std::numeric_limits<double>::digits10) << value;
-  return out.str();
-}
-
-void requireFinite(const char* field, double value) {
-  if (!std::isfinite(value)) {
-    throw InvalidOptions("CameraIntrinsics", field, toString(value), "must be finite");
-  }
-}
-
-void requirePositive(const char* field, double value) {
-  if (!std::isfinite(value) || value <= 0.0) {
-    throw InvalidOptions("CameraIntrinsics", field, toString(value), "must be finite and > 0");
-  }
-}
-
 // The distortion in plain scalars so that project() stays allocation free and branch light.
 // J (row-major 2x2, optional) receives d(xd, yd) / d(x, y).
 inline void distort(const CameraIntrinsics& c, double x, double y, double* xd, double* yd,
@@ -73,21 +54,20 @@ Eigen::Vector2d newtonStep(const Eigen::Matrix2d& J, const Eigen::Vector2d& resi
 }  // namespace
 
 void CameraIntrinsics::validate() const {
-  requirePositive("fx", fx);
-  requirePositive("fy", fy);
-  requireFinite("cx", cx);
-  requireFinite("cy", cy);
-  requireFinite("k1", k1);
-  requireFinite("k2", k2);
-  requireFinite("p1", p1);
-  requireFinite("p2", p2);
-  requireFinite("k3", k3);
-  if (width <= 0) {
-    throw InvalidOptions("CameraIntrinsics", "width", std::to_string(width), "must be > 0");
+  const OptionCheck require("CameraIntrinsics");
+  require.positive("fx", fx);
+  require.positive("fy", fy);
+  for (const auto& [field, value] : {std::pair{"cx", cx},
+                                     {"cy", cy},
+                                     {"k1", k1},
+                                     {"k2", k2},
+                                     {"p1", p1},
+                                     {"p2", p2},
+                                     {"k3", k3}}) {
+    require.finite(field, value);
   }
-  if (height <= 0) {
-    throw InvalidOptions("CameraIntrinsics", "height", std::to_string(height), "must be > 0");
-  }
+  require(width > 0, "width", width, "must be > 0");
+  require(height > 0, "height", height, "must be > 0");
 }
 
 Camera::Camera(const CameraIntrinsics& intrinsics) : intrinsics_(intrinsics) {

@@ -1,5 +1,6 @@
 #include "core/errors.h"
 
+#include <cmath>
 #include <locale>
 #include <sstream>
 
@@ -26,9 +27,21 @@ std::string formatOptionValue(double value) {
   return out.str();
 }
 
-void requireOption(bool ok, const std::string& struct_name, const std::string& field, double value,
-                   const std::string& constraint) {
-  if (!ok) throw InvalidOptions(struct_name, field, formatOptionValue(value), constraint);
+void OptionCheck::operator()(bool ok, const std::string& field, double value,
+                             const std::string& constraint) const {
+  if (!ok) throw InvalidOptions(struct_name_, field, formatOptionValue(value), constraint);
+}
+
+void OptionCheck::positive(const std::string& field, double value) const {
+  (*this)(value > 0.0 && std::isfinite(value), field, value, "must be > 0 and finite");
+}
+
+void OptionCheck::nonNegative(const std::string& field, double value) const {
+  (*this)(value >= 0.0 && std::isfinite(value), field, value, "must be >= 0 and finite");
+}
+
+void OptionCheck::finite(const std::string& field, double value) const {
+  (*this)(std::isfinite(value), field, value, "must be finite");
 }
 
 }  // namespace curvesfm

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace curvesfm {
 
@@ -43,10 +44,31 @@ class InvalidOptions : public Error {
 /// A number as options messages print it (shortest round-trip-ish form, C locale).
 std::string formatOptionValue(double value);
 
-/// For validate(): throws InvalidOptions(struct_name, field, formatOptionValue(value),
-/// constraint) unless `ok`. Write `ok` as a positive comparison (value >= low) so NaN fails.
-void requireOption(bool ok, const std::string& struct_name, const std::string& field, double value,
-                   const std::string& constraint);
+/// The checks of one options struct's validate(), so that every options error reads alike:
+///
+///   const OptionCheck require("CurveMapOptions");
+///   require(window >= 1, "window", window, ">= 1");
+///   require.positive("sigma", sigma);
+///
+/// Each throws InvalidOptions(struct, field, formatOptionValue(value), constraint) when the value
+/// breaks the constraint. Write a condition as a positive comparison (value >= low) so NaN fails.
+class OptionCheck {
+ public:
+  explicit OptionCheck(std::string struct_name) : struct_name_(std::move(struct_name)) {}
+
+  /// Throws unless `ok`.
+  void operator()(bool ok, const std::string& field, double value,
+                  const std::string& constraint) const;
+  /// > 0 and finite: "must be > 0 and finite".
+  void positive(const std::string& field, double value) const;
+  /// >= 0 and finite: "must be >= 0 and finite".
+  void nonNegative(const std::string& field, double value) const;
+  /// Finite: "must be finite".
+  void finite(const std::string& field, double value) const;
+
+ private:
+  std::string struct_name_;
+};
 
 /// A violated internal invariant (a programmer error), thrown by CURVESFM_CHECK.
 class CheckError : public Error {

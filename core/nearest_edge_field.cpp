@@ -647,10 +647,9 @@ class DistanceSweep {
 }  // namespace
 
 void NearestEdgeFieldOptions::validate() const {
-  if (max_distance_px < 1 || max_distance_px > 1000) {
-    throw InvalidOptions("NearestEdgeFieldOptions", "max_distance_px",
-                         std::to_string(max_distance_px), "in [1, 1000]");
-  }
+  const OptionCheck require("NearestEdgeFieldOptions");
+  require(max_distance_px >= 1 && max_distance_px <= 1000, "max_distance_px", max_distance_px,
+          "in [1, 1000]");
 }
 
 NearestEdgeField NearestEdgeField::build(const cv::Mat& edges, const cv::Mat& grad_x,

@@ -901,7 +901,8 @@ std::string formatValue(double value) {
 
 void require(bool ok, const char* struct_name, const std::string& field, double value,
              const std::string& constraint) {
-  requireOption(ok, struct_name, field, value, constraint);
+  const OptionCheck check(struct_name);
+  check(ok, field, value, constraint);
 }
 
 void validateSize(const char* struct_name, int width, int height, double font_scale) {

@@ -20,26 +20,6 @@ Pose3 Sim3::transformPose(const Pose3& source_from_cam) const {
                *this * source_from_cam.translation());
 }
 
-std::string toString(AlignmentKind kind) {
-  switch (kind) {
-    case AlignmentKind::kSim3:
-      return "sim3";
-    case AlignmentKind::kSe3:
-      return "se3";
-    case AlignmentKind::kNone:
-      return "none";
-  }
-  return "unknown";
-}
-
-AlignmentKind parseAlignmentKind(const std::string& name, const std::string& struct_name,
-                                 const std::string& field) {
-  for (auto kind : {AlignmentKind::kSim3, AlignmentKind::kSe3, AlignmentKind::kNone}) {
-    if (name == toString(kind)) return kind;
-  }
-  throw InvalidOptions(struct_name, field, "\"" + name + "\"", "expected one of sim3, se3, none");
-}
-
 bool hasSpreadForScale(const Eigen::Matrix3Xd& points) {
   if (points.cols() == 0) return false;
   const Eigen::Vector3d centroid = points.rowwise().mean();

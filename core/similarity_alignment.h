@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "core/enum_names.h"
 #include "core/pose3.h"
 
 namespace curvesfm {
@@ -32,13 +33,14 @@ enum class AlignmentKind {
   kNone,  ///< The identity: compare the estimate in its own frame.
 };
 
-/// "sim3", "se3", "none".
-std::string toString(AlignmentKind kind);
-
-/// The kind named by toString(); anything else throws InvalidOptions naming `struct_name`.`field`
-/// and the accepted names.
-AlignmentKind parseAlignmentKind(const std::string& name, const std::string& struct_name,
-                                 const std::string& field);
+template <>
+struct EnumNames<AlignmentKind> {
+  static constexpr std::array<std::pair<AlignmentKind, const char*>, 3> kNames = {{
+      {AlignmentKind::kSim3, "sim3"},
+      {AlignmentKind::kSe3, "se3"},
+      {AlignmentKind::kNone, "none"},
+  }};
+};
 
 /// The least-squares alignment target_from_source of two corresponding point sets (Umeyama 1991,
 /// "Least-squares estimation of transformation parameters between two point patterns"): the

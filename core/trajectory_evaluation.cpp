@@ -14,12 +14,6 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-std::string formatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
 // The camera centres (world_from_cam translations) of the matched poses of one trajectory, as
 // columns; `side` picks the index into `poses` from a match.
 Eigen::Matrix3Xd matchedCentres(const std::vector<StampedPose>& poses,
@@ -60,7 +54,7 @@ void checkAlignable(const TrajectoryEvaluation& evaluation,
         estimate_name, ground_truth_name,
         "matched " + std::to_string(matched) + " of " + std::to_string(evaluation.estimate_poses) +
             " estimated poses (" + std::to_string(evaluation.ground_truth_poses) +
-            " ground-truth) within max_dt " + formatNumber(options.max_dt) + " s; " +
+            " ground-truth) within max_dt " + formatOptionValue(options.max_dt) + " s; " +
             toString(options.alignment) + " alignment needs at least " +
             std::to_string(minimumMatches(options.alignment)));
   }
@@ -122,14 +116,10 @@ std::vector<StampedPose> stampedByIndex(const std::vector<Pose3>& cam_from_world
 }  // namespace
 
 void TrajectoryEvaluationOptions::validate() const {
-  if (!(std::isfinite(max_dt) && max_dt >= 0.0)) {
-    throw InvalidOptions("TrajectoryEvaluationOptions", "max_dt", formatNumber(max_dt),
-                         "must be finite and >= 0 (seconds)");
-  }
-  if (rpe_delta < 1) {
-    throw InvalidOptions("TrajectoryEvaluationOptions", "rpe_delta", std::to_string(rpe_delta),
-                         "must be >= 1 (frames)");
-  }
+  const OptionCheck require("TrajectoryEvaluationOptions");
+  require(std::isfinite(max_dt) && max_dt >= 0.0, "max_dt", max_dt,
+          "must be finite and >= 0 (seconds)");
+  require(rpe_delta >= 1, "rpe_delta", rpe_delta, "must be >= 1 (frames)");
 }
 
 ErrorStatistics computeErrorStatistics(const std::vector<double>& errors) {

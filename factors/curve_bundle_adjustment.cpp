@@ -72,33 +72,19 @@ void addMotionPrior(const std::vector<Pose3>& prior_cam_from_world,
 }  // namespace
 
 void CurveBundleAdjustmentOptions::validate() const {
-  const char* name = "CurveBundleAdjustmentOptions";
-  if (samples_per_segment < 1 || samples_per_segment >= CurveReprojectionFactor::kMaxSamples) {
-    throw InvalidOptions(
-        name, "samples_per_segment", std::to_string(samples_per_segment),
-        "must be in [1, " + std::to_string(CurveReprojectionFactor::kMaxSamples - 1) + "]");
-  }
-  auto positive = [&](double value, const char* field) {
-    if (!(value > 0.0 && std::isfinite(value))) {
-      throw InvalidOptions(name, field, std::to_string(value), "must be > 0 and finite");
-    }
-  };
-  auto non_negative = [&](double value, const char* field) {
-    if (!(value >= 0.0 && std::isfinite(value))) {
-      throw InvalidOptions(name, field, std::to_string(value), "must be >= 0 and finite");
-    }
-  };
-  if (!(max_normal_angle_deg > 0.0 && max_normal_angle_deg <= 90.0)) {
-    throw InvalidOptions(name, "max_normal_angle_deg", std::to_string(max_normal_angle_deg),
-                         "must be in (0, 90]");
-  }
-  positive(pixel_sigma, "pixel_sigma");
-  positive(kernel_width, "kernel_width");
-  non_negative(lambda1, "lambda1");
-  non_negative(lambda2, "lambda2");
-  positive(scale_sigma, "scale_sigma");
-  positive(motion_prior_rotation_sigma_deg, "motion_prior_rotation_sigma_deg");
-  positive(motion_prior_translation_sigma_rel, "motion_prior_translation_sigma_rel");
+  const OptionCheck require("CurveBundleAdjustmentOptions");
+  require(samples_per_segment >= 1 && samples_per_segment < CurveReprojectionFactor::kMaxSamples,
+          "samples_per_segment", samples_per_segment,
+          "must be in [1, " + std::to_string(CurveReprojectionFactor::kMaxSamples - 1) + "]");
+  require(max_normal_angle_deg > 0.0 && max_normal_angle_deg <= 90.0, "max_normal_angle_deg",
+          max_normal_angle_deg, "must be in (0, 90]");
+  require.positive("pixel_sigma", pixel_sigma);
+  require.positive("kernel_width", kernel_width);
+  require.nonNegative("lambda1", lambda1);
+  require.nonNegative("lambda2", lambda2);
+  require.positive("scale_sigma", scale_sigma);
+  require.positive("motion_prior_rotation_sigma_deg", motion_prior_rotation_sigma_deg);
+  require.positive("motion_prior_translation_sigma_rel", motion_prior_translation_sigma_rel);
 }
 
 CurveBundleAdjustmentProblem buildCurveBundleAdjustment(

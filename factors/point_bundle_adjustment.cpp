@@ -9,15 +9,10 @@
 namespace curvesfm {
 
 void PointBundleAdjustmentOptions::validate() const {
-  auto positive = [](double value, const char* field) {
-    if (!(value > 0.0 && std::isfinite(value))) {
-      throw InvalidOptions("PointBundleAdjustmentOptions", field, std::to_string(value),
-                           "must be > 0 and finite");
-    }
-  };
-  positive(pixel_sigma, "pixel_sigma");
-  positive(kernel_width, "kernel_width");
-  positive(scale_sigma, "scale_sigma");
+  const OptionCheck require("PointBundleAdjustmentOptions");
+  require.positive("pixel_sigma", pixel_sigma);
+  require.positive("kernel_width", kernel_width);
+  require.positive("scale_sigma", scale_sigma);
 }
 
 PointBundleAdjustmentProblem buildPointBundleAdjustment(

@@ -2,24 +2,16 @@
 #include <ceres/solver.h>
 
 #include <algorithm>
-#include <chrono>
 
+#include "core/clock.h"
 #include "graph/ceres_problem.h"
 #include "graph/optimizer.h"
 
 namespace curvesfm {
-namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
-
-OptimizationSummary optimize(const FactorGraph& graph, Values* values,
-                             const ProblemConfig& config, const OptimizerOptions& options) {
+OptimizationSummary optimize(const FactorGraph& graph, Values* values, const ProblemConfig& config,
+                             const OptimizerOptions& options) {
   options.validate();
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   OptimizationSummary summary;
   summary.num_factors = static_cast<int>(graph.size());
 
@@ -30,8 +22,8 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values,
   if (options.structure_first_ordering) {
     std::string why_not;
     ceres_options.linear_solver_ordering = bridge.structureFirstOrdering(&why_not);
-    summary.ordering = ceres_options.linear_solver_ordering ? "structure_first"
-                                                            : "automatic (" + why_not + ")";
+    summary.ordering =
+        ceres_options.linear_solver_ordering ? "structure_first" : "automatic (" + why_not + ")";
   }
   if (options.use_inner_iterations) {
     ceres_options.inner_iteration_ordering = bridge.innerIterationOrdering();
@@ -40,12 +32,12 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values,
   summary.num_free_variables = static_cast<int>(bridge.keys().size()) - bridge.numConstant();
   summary.setup_seconds = secondsSince(start);
 
-  const auto solve_start = std::chrono::steady_clock::now();
+  const auto solve_start = Clock::now();
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(ceres_options, &bridge.problem(), &ceres_summary);
   summary.solve_seconds = secondsSince(solve_start);
 
-  const auto writeback_start = std::chrono::steady_clock::now();
+  const auto writeback_start = Clock::now();
   bridge.writeBack(values);
   summary.final_cost_by_type = bridge.costByType();
   summary.writeback_seconds = secondsSince(writeback_start);

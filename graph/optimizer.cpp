@@ -7,69 +7,13 @@
 #include "core/errors.h"
 
 namespace curvesfm {
-namespace {
-
-template <class Enum>
-Enum parseEnum(const std::string& name, const std::string& field, const char* struct_name,
-               std::initializer_list<Enum> all) {
-  std::string accepted;
-  for (Enum value : all) {
-    if (name == toString(value)) return value;
-    accepted += (accepted.empty() ? "" : ", ") + toString(value);
-  }
-  throw InvalidOptions(struct_name, field, "\"" + name + "\"", "expected one of " + accepted);
-}
-
-void requirePositive(double value, const char* field) {
-  if (!(value > 0.0 && std::isfinite(value))) {
-    throw InvalidOptions("OptimizerOptions", field, std::to_string(value),
-                         "must be > 0 and finite");
-  }
-}
-
-}  // namespace
-
-std::string toString(LinearSolver solver) {
-  switch (solver) {
-    case LinearSolver::kSparseSchur: return "sparse_schur";
-    case LinearSolver::kDenseSchur: return "dense_schur";
-    case LinearSolver::kIterativeSchur: return "iterative_schur";
-    case LinearSolver::kSparseNormalCholesky: return "sparse_normal_cholesky";
-  }
-  return "unknown";
-}
-
-std::string toString(TrustRegion strategy) {
-  switch (strategy) {
-    case TrustRegion::kLevenbergMarquardt: return "levenberg_marquardt";
-    case TrustRegion::kDogleg: return "dogleg";
-  }
-  return "unknown";
-}
-
-LinearSolver parseLinearSolver(const std::string& name, const std::string& field) {
-  return parseEnum(name, field, "OptimizerOptions",
-                   {LinearSolver::kSparseSchur, LinearSolver::kDenseSchur,
-                    LinearSolver::kIterativeSchur, LinearSolver::kSparseNormalCholesky});
-}
-
-TrustRegion parseTrustRegion(const std::string& name, const std::string& field) {
-  return parseEnum(name, field, "OptimizerOptions",
-                   {TrustRegion::kLevenbergMarquardt, TrustRegion::kDogleg});
-}
-
 void OptimizerOptions::validate() const {
-  if (max_iterations < 0) {
-    throw InvalidOptions("OptimizerOptions", "max_iterations", std::to_string(max_iterations),
-                         "must be >= 0");
-  }
-  if (num_threads < 1) {
-    throw InvalidOptions("OptimizerOptions", "num_threads", std::to_string(num_threads),
-                         "must be >= 1");
-  }
-  requirePositive(function_tolerance, "function_tolerance");
-  requirePositive(gradient_tolerance, "gradient_tolerance");
-  requirePositive(parameter_tolerance, "parameter_tolerance");
+  const OptionCheck require("OptimizerOptions");
+  require(max_iterations >= 0, "max_iterations", max_iterations, "must be >= 0");
+  require(num_threads >= 1, "num_threads", num_threads, "must be >= 1");
+  require.positive("function_tolerance", function_tolerance);
+  require.positive("gradient_tolerance", gradient_tolerance);
+  require.positive("parameter_tolerance", parameter_tolerance);
 }
 
 std::string OptimizationSummary::toString() const {

@@ -4,6 +4,7 @@
 #include <set>
 #include <string>
 
+#include "core/enum_names.h"
 #include "graph/factor_graph.h"
 #include "graph/key.h"
 #include "graph/values.h"
@@ -13,8 +14,8 @@ namespace curvesfm {
 /// What to optimise: the variables held constant, by key or by category (COLMAP keeps this
 /// apart from how to solve, and so do we). Everything else that a factor touches is free.
 struct ProblemConfig {
-  std::set<Key> constant_keys;                       ///< Held at their current value.
-  std::set<VariableCategory> constant_categories;    ///< Every variable of these categories.
+  std::set<Key> constant_keys;                     ///< Held at their current value.
+  std::set<VariableCategory> constant_categories;  ///< Every variable of these categories.
 
   void setConstant(Key key) { constant_keys.insert(key); }
   void setConstant(VariableCategory category) { constant_categories.insert(category); }
@@ -26,13 +27,22 @@ struct ProblemConfig {
 enum class LinearSolver { kSparseSchur, kDenseSchur, kIterativeSchur, kSparseNormalCholesky };
 enum class TrustRegion { kLevenbergMarquardt, kDogleg };
 
-/// "sparse_schur", "dense_schur", "iterative_schur", "sparse_normal_cholesky".
-std::string toString(LinearSolver solver);
-/// "levenberg_marquardt", "dogleg".
-std::string toString(TrustRegion strategy);
-/// Inverses of toString; throw InvalidOptions naming `field` and the accepted names.
-LinearSolver parseLinearSolver(const std::string& name, const std::string& field);
-TrustRegion parseTrustRegion(const std::string& name, const std::string& field);
+template <>
+struct EnumNames<LinearSolver> {
+  static constexpr std::array<std::pair<LinearSolver, const char*>, 4> kNames = {{
+      {LinearSolver::kSparseSchur, "sparse_schur"},
+      {LinearSolver::kDenseSchur, "dense_schur"},
+      {LinearSolver::kIterativeSchur, "iterative_schur"},
+      {LinearSolver::kSparseNormalCholesky, "sparse_normal_cholesky"},
+  }};
+};
+template <>
+struct EnumNames<TrustRegion> {
+  static constexpr std::array<std::pair<TrustRegion, const char*>, 2> kNames = {{
+      {TrustRegion::kLevenbergMarquardt, "levenberg_marquardt"},
+      {TrustRegion::kDogleg, "dogleg"},
+  }};
+};
 
 /// How to solve (the Ceres settings we expose).
 struct OptimizerOptions {
@@ -40,8 +50,8 @@ struct OptimizerOptions {
   /// first; iterative_schur uses the SCHUR_JACOBI preconditioner; sparse ones use SuiteSparse.
   LinearSolver linear_solver = LinearSolver::kSparseSchur;
   TrustRegion trust_region = TrustRegion::kLevenbergMarquardt;  ///< Step strategy.
-  int max_iterations = 50;          ///< Outer iterations; >= 0.
-  int num_threads = 1;              ///< Threads for evaluation and linear algebra; >= 1.
+  int max_iterations = 50;                                      ///< Outer iterations; >= 0.
+  int num_threads = 1;                ///< Threads for evaluation and linear algebra; >= 1.
   double function_tolerance = 1e-6;   ///< Stop when |dcost|/cost < this; > 0.
   double gradient_tolerance = 1e-10;  ///< Stop when max |gradient| < this; > 0.
   double parameter_tolerance = 1e-8;  ///< Stop when |dx| / (|x| + tol) < this; > 0.
@@ -62,12 +72,12 @@ struct OptimizationSummary {
   double final_cost = 0.0;
   std::map<std::string, FactorTypeCost> initial_cost_by_type;  ///< Per Factor::typeName().
   std::map<std::string, FactorTypeCost> final_cost_by_type;
-  int iterations = 0;            ///< Outer iterations Ceres ran (excluding iteration 0).
-  bool usable = false;           ///< Ceres' IsSolutionUsable(): converged or hit a limit.
-  std::string termination;       ///< "CONVERGENCE", "NO_CONVERGENCE" (iteration limit), ...
-  std::string message;           ///< Ceres' reason for terminating.
-  std::string linear_solver;     ///< Linear solver Ceres actually used.
-  std::string ordering;          ///< "structure_first" or why Ceres chose ("automatic: ...").
+  int iterations = 0;         ///< Outer iterations Ceres ran (excluding iteration 0).
+  bool usable = false;        ///< Ceres' IsSolutionUsable(): converged or hit a limit.
+  std::string termination;    ///< "CONVERGENCE", "NO_CONVERGENCE" (iteration limit), ...
+  std::string message;        ///< Ceres' reason for terminating.
+  std::string linear_solver;  ///< Linear solver Ceres actually used.
+  std::string ordering;       ///< "structure_first" or why Ceres chose ("automatic: ...").
   int num_factors = 0;
   int num_free_variables = 0;
   int num_constant_variables = 0;
@@ -78,7 +88,7 @@ struct OptimizationSummary {
   double minimizer_seconds = 0.0;    ///< Ceres' time in the minimiser (iterations only).
   double writeback_seconds = 0.0;    ///< Results back into Values, and per-type costs.
   double total_seconds = 0.0;
-  std::string full_report;           ///< Ceres' FullReport().
+  std::string full_report;  ///< Ceres' FullReport().
 
   /// A compact multi-line block: costs before/after per factor type, iterations, times.
   std::string toString() const;
@@ -87,7 +97,7 @@ struct OptimizationSummary {
 /// Minimises the graph's cost over the free variables of `values` (updated in place) with Ceres.
 /// Every key a factor uses must be in `values` with the factor's type (KeyDoesNotExist /
 /// IncorrectType otherwise); variables no factor touches are left alone.
-OptimizationSummary optimize(const FactorGraph& graph, Values* values,
-                             const ProblemConfig& config, const OptimizerOptions& options);
+OptimizationSummary optimize(const FactorGraph& graph, Values* values, const ProblemConfig& config,
+                             const OptimizerOptions& options);
 
 }  // namespace curvesfm

@@ -7,25 +7,6 @@
 
 namespace curvesfm {
 
-std::string toString(RobustKernelType type) {
-  switch (type) {
-    case RobustKernelType::kNone: return "none";
-    case RobustKernelType::kHuber: return "huber";
-    case RobustKernelType::kCauchy: return "cauchy";
-    case RobustKernelType::kTukey: return "tukey";
-  }
-  return "unknown";
-}
-
-RobustKernelType parseRobustKernelType(const std::string& name, const std::string& field) {
-  for (auto type : {RobustKernelType::kNone, RobustKernelType::kHuber, RobustKernelType::kCauchy,
-                    RobustKernelType::kTukey}) {
-    if (name == toString(type)) return type;
-  }
-  throw InvalidOptions("RobustKernel", field, "\"" + name + "\"",
-                       "expected one of none, huber, cauchy, tukey");
-}
-
 RobustKernel::RobustKernel(RobustKernelType type, double width) : type_(type), width_(width) {
   if (type != RobustKernelType::kNone && !(width > 0.0 && std::isfinite(width))) {
     throw InvalidOptions("RobustKernel", "width", std::to_string(width),

@@ -2,14 +2,21 @@
 
 #include <string>
 
+#include "core/enum_names.h"
+
 namespace curvesfm {
 
 enum class RobustKernelType { kNone, kHuber, kCauchy, kTukey };
 
-/// "none", "huber", "cauchy", "tukey".
-std::string toString(RobustKernelType type);
-/// Inverse of toString; throws InvalidOptions naming `field` for an unknown name.
-RobustKernelType parseRobustKernelType(const std::string& name, const std::string& field);
+template <>
+struct EnumNames<RobustKernelType> {
+  static constexpr std::array<std::pair<RobustKernelType, const char*>, 4> kNames = {{
+      {RobustKernelType::kNone, "none"},
+      {RobustKernelType::kHuber, "huber"},
+      {RobustKernelType::kCauchy, "cauchy"},
+      {RobustKernelType::kTukey, "tukey"},
+  }};
+};
 
 /// A robust kernel rho(s) of the squared whitened residual norm s = |r/sigma|^2, in Ceres'
 /// convention: the cost of a residual block is 0.5 * rho(s); rho(s) = s without a kernel.
@@ -42,8 +49,8 @@ class RobustKernel {
 /// How a factor's error is weighted: whitened error r / sigma, then the robust kernel.
 /// The information weight is 1 / sigma^2. Isotropic: one sigma for every residual row.
 struct NoiseModel {
-  double sigma = 1.0;    ///< Standard deviation of every residual row, in the residual's unit; > 0.
-  RobustKernel kernel;   ///< Robust kernel on the whitened squared norm; none by default.
+  double sigma = 1.0;   ///< Standard deviation of every residual row, in the residual's unit; > 0.
+  RobustKernel kernel;  ///< Robust kernel on the whitened squared norm; none by default.
 
   /// Throws InvalidOptions unless sigma > 0 and finite.
   void validate() const;

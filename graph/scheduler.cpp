@@ -1,7 +1,6 @@
 #include "graph/scheduler.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <iterator>
@@ -9,35 +8,17 @@
 #include <unordered_set>
 
 #include "core/check.h"
+#include "core/clock.h"
 #include "core/errors.h"
 
 namespace curvesfm {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 constexpr VariableCategory kStructureCategories[] = {
     VariableCategory::kPoint, VariableCategory::kCurvePoint, VariableCategory::kDirection,
     VariableCategory::kLength, VariableCategory::kOther};
 
 bool isPose(Key key) { return categoryOf(key) == VariableCategory::kPose; }
-
-std::string number(double value) {
-  std::ostringstream os;
-  os << std::setprecision(6) << value;
-  return os.str();
-}
-
-template <class Enum>
-Enum parseEnum(const std::string& name, const std::string& field, std::initializer_list<Enum> all) {
-  std::string accepted;
-  for (Enum value : all) {
-    if (name == toString(value)) return value;
-    accepted += (accepted.empty() ? "" : ", ") + toString(value);
-  }
-  throw InvalidOptions("SchedulerOptions", field, "\"" + name + "\"",
-                       "expected one of " + accepted);
-}
 
 // The factors sent to the solver, the variables they touch and what every phase holds constant.
 struct ActiveSet {
@@ -193,7 +174,7 @@ bool roundEndsSchedule(int round, std::size_t first, const SchedulerOptions& opt
   roundCosts(*report, first, &before, &after);
   if (after > before) {
     report->warnings.push_back("round " + std::to_string(round) + ": cost rose from " +
-                               number(before) + " to " + number(after));
+                               formatOptionValue(before) + " to " + formatOptionValue(after));
   }
   if (!poses_ran || !structure_ran) {
     // With one phase empty a round is a joint solve; another round would repeat it.
@@ -207,15 +188,15 @@ bool roundEndsSchedule(int round, std::size_t first, const SchedulerOptions& opt
   const double change = before > 0.0 ? (before - after) / before : 0.0;
   if (change < options.round_tolerance) {
     stop(true,
-         "round " + std::to_string(round) + ": relative cost change " + number(change) +
-             " < round_tolerance " + number(options.round_tolerance),
+         "round " + std::to_string(round) + ": relative cost change " + formatOptionValue(change) +
+             " < round_tolerance " + formatOptionValue(options.round_tolerance),
          report);
     return true;
   }
   if (round < options.max_rounds) return false;
   stop(false,
        "max_rounds = " + std::to_string(options.max_rounds) +
-           " reached; last relative cost change " + number(change),
+           " reached; last relative cost change " + formatOptionValue(change),
        report);
   return true;
 }
@@ -256,50 +237,11 @@ void writeCostRows(std::ostream& os, const ScheduleRound& entry) {
 
 }  // namespace
 
-std::string toString(Strategy strategy) {
-  switch (strategy) {
-    case Strategy::kJoint:
-      return "joint";
-    case Strategy::kAlternating:
-      return "alternating";
-    case Strategy::kInnerIterations:
-      return "inner_iterations";
-  }
-  return "unknown";
-}
-
-std::string toString(Scope scope) {
-  switch (scope) {
-    case Scope::kGlobal:
-      return "global";
-    case Scope::kLocal:
-      return "local";
-  }
-  return "unknown";
-}
-
-Strategy parseStrategy(const std::string& name, const std::string& field) {
-  return parseEnum(name, field,
-                   {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations});
-}
-
-Scope parseScope(const std::string& name, const std::string& field) {
-  return parseEnum(name, field, {Scope::kGlobal, Scope::kLocal});
-}
-
 void SchedulerOptions::validate() const {
-  if (local_window < 1) {
-    throw InvalidOptions("SchedulerOptions", "local_window", std::to_string(local_window),
-                         "must be >= 1");
-  }
-  if (max_rounds < 1) {
-    throw InvalidOptions("SchedulerOptions", "max_rounds", std::to_string(max_rounds),
-                         "must be >= 1");
-  }
-  if (!(round_tolerance >= 0.0 && std::isfinite(round_tolerance))) {
-    throw InvalidOptions("SchedulerOptions", "round_tolerance", number(round_tolerance),
-                         "must be >= 0 and finite");
-  }
+  const OptionCheck require("SchedulerOptions");
+  require(local_window >= 1, "local_window", local_window, "must be >= 1");
+  require(max_rounds >= 1, "max_rounds", max_rounds, "must be >= 1");
+  require.nonNegative("round_tolerance", round_tolerance);
   optimizer.validate();
 }
 
@@ -349,7 +291,7 @@ ScheduleReport runSchedule(const FactorGraph& graph, Values* values, const Probl
   if (!roundCosts(report, 0, &report.initial_cost, &report.final_cost)) {
     report.initial_cost = report.final_cost = active.graph().cost(*values);
   }
-  report.total_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  report.total_seconds = secondsSince(start);
   return report;
 }
 

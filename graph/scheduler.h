@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "graph/factor_graph.h"
 #include "graph/optimizer.h"
 #include "graph/values.h"
@@ -33,13 +34,21 @@ enum class Scope {
   kLocal,
 };
 
-/// "joint", "alternating", "inner_iterations".
-std::string toString(Strategy strategy);
-/// "global", "local".
-std::string toString(Scope scope);
-/// Inverses of toString; throw InvalidOptions naming `field` and the accepted names.
-Strategy parseStrategy(const std::string& name, const std::string& field);
-Scope parseScope(const std::string& name, const std::string& field);
+template <>
+struct EnumNames<Strategy> {
+  static constexpr std::array<std::pair<Strategy, const char*>, 3> kNames = {{
+      {Strategy::kJoint, "joint"},
+      {Strategy::kAlternating, "alternating"},
+      {Strategy::kInnerIterations, "inner_iterations"},
+  }};
+};
+template <>
+struct EnumNames<Scope> {
+  static constexpr std::array<std::pair<Scope, const char*>, 2> kNames = {{
+      {Scope::kGlobal, "global"},
+      {Scope::kLocal, "local"},
+  }};
+};
 
 /// What the scheduler solves and when it stops. The gauge: with fix_first_pose the pose of
 /// smallest index among those the graph uses is constant in every phase (in both scopes); the

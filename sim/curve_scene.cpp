@@ -66,10 +66,6 @@ constexpr unsigned kRenderStream = 3;
 // ------------------------------------------------------------------------------------------
 // Options.
 
-void require(bool ok, const char* field, double value, const char* constraint) {
-  requireOption(ok, "CurveSceneOptions", field, value, constraint);
-}
-
 bool inRange(double value, double low, double high) { return value >= low && value <= high; }
 
 // ------------------------------------------------------------------------------------------
@@ -767,54 +763,10 @@ double bilinear(const cv::Mat1f& image, double x, double y) {
          fy * ((1.0 - fx) * image(y0 + 1, x0) + fx * image(y0 + 1, x0 + 1));
 }
 
-template <class Enum>
-Enum parseSceneEnum(const std::string& name, const std::string& field,
-                    std::initializer_list<Enum> all) {
-  std::string accepted;
-  for (Enum value : all) {
-    if (name == toString(value)) return value;
-    accepted += (accepted.empty() ? "" : ", ") + toString(value);
-  }
-  throw InvalidOptions("CurveSceneOptions", field, "\"" + name + "\"",
-                       "expected one of " + accepted);
-}
-
 }  // namespace
 
-std::string toString(CameraPath path) {
-  switch (path) {
-    case CameraPath::kOrbit:
-      return "orbit";
-    case CameraPath::kForwardWalk:
-      return "forward_walk";
-  }
-  return "unknown";
-}
-
-std::string toString(CurveKind kind) {
-  switch (kind) {
-    case CurveKind::kLine:
-      return "line";
-    case CurveKind::kArc:
-      return "arc";
-    case CurveKind::kHelix:
-      return "helix";
-    case CurveKind::kMixed:
-      return "mixed";
-  }
-  return "unknown";
-}
-
-CameraPath parseCameraPath(const std::string& name, const std::string& field) {
-  return parseSceneEnum(name, field, {CameraPath::kOrbit, CameraPath::kForwardWalk});
-}
-
-CurveKind parseCurveKind(const std::string& name, const std::string& field) {
-  return parseSceneEnum(name, field,
-                        {CurveKind::kLine, CurveKind::kArc, CurveKind::kHelix, CurveKind::kMixed});
-}
-
 void CurveSceneOptions::validate() const {
+  const OptionCheck require("CurveSceneOptions");
   require(num_keyframes >= 2, "num_keyframes", num_keyframes, "must be >= 2");
   require(camera_path == CameraPath::kOrbit || camera_path == CameraPath::kForwardWalk,
           "camera_path", static_cast<int>(camera_path), "must be kOrbit or kForwardWalk");

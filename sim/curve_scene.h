@@ -8,6 +8,7 @@
 
 #include "core/bezier.h"
 #include "core/camera.h"
+#include "core/enum_names.h"
 #include "core/pose3.h"
 
 namespace curvesfm {
@@ -40,13 +41,22 @@ enum class CurveKind {
   kMixed,  ///< Each curve picks one of the three kinds above at random (options only).
 };
 
-/// Names of the scene enums on the command line and in reports: "orbit", "forward_walk"; "line",
-/// "arc", "helix", "mixed". The parsers throw InvalidOptions naming CurveSceneOptions, `field`
-/// and the accepted names.
-std::string toString(CameraPath path);
-std::string toString(CurveKind kind);
-CameraPath parseCameraPath(const std::string& name, const std::string& field);
-CurveKind parseCurveKind(const std::string& name, const std::string& field);
+template <>
+struct EnumNames<CameraPath> {
+  static constexpr std::array<std::pair<CameraPath, const char*>, 2> kNames = {{
+      {CameraPath::kOrbit, "orbit"},
+      {CameraPath::kForwardWalk, "forward_walk"},
+  }};
+};
+template <>
+struct EnumNames<CurveKind> {
+  static constexpr std::array<std::pair<CurveKind, const char*>, 4> kNames = {{
+      {CurveKind::kLine, "line"},
+      {CurveKind::kArc, "arc"},
+      {CurveKind::kHelix, "helix"},
+      {CurveKind::kMixed, "mixed"},
+  }};
+};
 
 struct CurveSceneOptions {
   // --- cameras ---

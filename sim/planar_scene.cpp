@@ -22,10 +22,6 @@ constexpr double kDegToRad = M_PI / 180.0;
 // Far beyond any real camera; it keeps a mistyped size from allocating gigabytes per frame.
 constexpr int kMaxImageSide = 16384;
 
-void require(bool ok, const char* field, double value, const char* constraint) {
-  requireOption(ok, "PlanarSceneOptions", field, value, constraint);
-}
-
 void checkTexture(const cv::Mat& texture) {
   CURVESFM_CHECK(!texture.empty() && texture.depth() == CV_8U &&
                  (texture.channels() == 1 || texture.channels() == 3))
@@ -138,6 +134,7 @@ CameraIntrinsics PlanarSceneOptions::intrinsics() const {
 }
 
 void PlanarSceneOptions::validate() const {
+  const OptionCheck require("PlanarSceneOptions");
   require(num_frames >= 2, "num_frames", num_frames, "must be >= 2");
   require(intensity_noise >= 0.0 && intensity_noise <= 1.0, "intensity_noise", intensity_noise,
           "must be in [0, 1] (a fraction of 255)");
@@ -213,24 +210,6 @@ double PlanarScene::meanFrameBaseline() const { return meanCameraStep(true_cam_f
 double PlanarScene::firstToLastBaseline() const {
   if (true_cam_from_world.empty()) return 0.0;
   return cameraCentreDistance(true_cam_from_world.back(), true_cam_from_world.front());
-}
-
-std::string toString(InitNoiseModel model) {
-  switch (model) {
-    case InitNoiseModel::kIndependent:
-      return "independent";
-    case InitNoiseModel::kDrift:
-      return "drift";
-  }
-  return "unknown";
-}
-
-InitNoiseModel parseInitNoiseModel(const std::string& name, const std::string& field) {
-  for (const InitNoiseModel model : {InitNoiseModel::kIndependent, InitNoiseModel::kDrift}) {
-    if (name == toString(model)) return model;
-  }
-  throw InvalidOptions("PlanarSceneOptions", field, "\"" + name + "\"",
-                       "expected one of independent, drift");
 }
 
 PlanarScene makePlanarScene(const cv::Mat& texture_bgr, const PlanarSceneOptions& options) {

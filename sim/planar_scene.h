@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "core/enum_names.h"
 #include "core/pose3.h"
 
 namespace curvesfm {
@@ -37,11 +38,13 @@ enum class InitNoiseModel {
   kDrift,
 };
 
-/// "independent", "drift".
-std::string toString(InitNoiseModel model);
-/// The model named `name`; InvalidOptions("PlanarSceneOptions", field, ...) listing the names
-/// otherwise.
-InitNoiseModel parseInitNoiseModel(const std::string& name, const std::string& field);
+template <>
+struct EnumNames<InitNoiseModel> {
+  static constexpr std::array<std::pair<InitNoiseModel, const char*>, 2> kNames = {{
+      {InitNoiseModel::kIndependent, "independent"},
+      {InitNoiseModel::kDrift, "drift"},
+  }};
+};
 
 /// Options of makePlanarScene(). The default orbit (height 0.6 m, radius 0.25 m, 90 deg arc)
 /// keeps the camera 0.65 m from the photo's centre, 23 deg off the vertical: a default 4:3 photo

@@ -13,10 +13,6 @@ namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-void require(bool ok, const char* field, double value, const char* constraint) {
-  if (!ok) throw InvalidOptions("PointSceneOptions", field, std::to_string(value), constraint);
-}
-
 // Camera at `centre` looking at the origin, image y pointing along world +y ("down").
 Pose3 lookAtOrigin(const Eigen::Vector3d& centre) {
   const Eigen::Vector3d z = (-centre).normalized();
@@ -43,6 +39,7 @@ Pose3 perturb(const Pose3& cam_from_world, double rotation_sigma, double centre_
 }  // namespace
 
 void PointSceneOptions::validate() const {
+  const OptionCheck require("PointSceneOptions");
   require(num_cameras >= 2, "num_cameras", num_cameras, "must be >= 2");
   require(num_points >= 1, "num_points", num_points, "must be >= 1");
   require(track_length >= 1 && track_length <= num_cameras, "track_length", track_length,

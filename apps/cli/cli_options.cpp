@@ -60,10 +60,10 @@ CLI::Option* addBoolFlag(CLI::App* command, const std::string& name, bool* targe
 }
 
 void addOptimizerFlags(CLI::App* command, OptimizerOptions* options) {
-  addEnumFlag(command, "linear-solver", &options->linear_solver, parseLinearSolver,
+  addEnumFlag(command, "linear-solver", &options->linear_solver,
               "Linear solver of each step: sparse_schur, dense_schur, iterative_schur, "
               "sparse_normal_cholesky");
-  addEnumFlag(command, "trust-region", &options->trust_region, parseTrustRegion,
+  addEnumFlag(command, "trust-region", &options->trust_region,
               "Trust-region strategy: levenberg_marquardt, dogleg");
   command->add_option("--max-iterations", options->max_iterations, "Maximum solver iterations")
       ->capture_default_str();
@@ -89,15 +89,14 @@ void addOptimizerFlags(CLI::App* command, OptimizerOptions* options) {
 
 CLI::Option* addKernelFlag(CLI::App* command, const std::string& name, RobustKernelType* kernel,
                            const std::string& description) {
-  return addEnumFlag(command, name, kernel, parseRobustKernelType,
-                     description + ": none, huber, cauchy, tukey");
+  return addEnumFlag(command, name, kernel, description + ": none, huber, cauchy, tukey");
 }
 
 void addSchedulerFlags(CLI::App* command, SchedulerOptions* options) {
-  addEnumFlag(command, "strategy", &options->strategy, parseStrategy,
+  addEnumFlag(command, "strategy", &options->strategy,
               "How the free variables are split into solves: joint, alternating (poses, then "
               "structure, per round), inner_iterations");
-  addEnumFlag(command, "scope", &options->scope, parseScope,
+  addEnumFlag(command, "scope", &options->scope,
               "Free variables: global (all), local (the last --local-window cameras and the "
               "structure they see)");
   command->add_option("--local-window", options->local_window, "Free cameras in local scope")

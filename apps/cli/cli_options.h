@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "core/errors.h"
 #include "factors/curve_reprojection_factor.h"
 #include "graph/optimizer.h"
@@ -14,23 +15,24 @@
 
 namespace curvesfm {
 
-/// Registers `--<name>` taking an enum by name. `parse(value, name)` converts it and throws
-/// InvalidOptions listing the accepted names for an unknown one, which CLI11 turns into a usage
-/// error naming the flag. The option keeps the name the user gave, so the echoed configuration
-/// shows names; the default shown is `toString(*target)`.
+/// Registers `--<name>` taking an enum by name (EnumNames). An unknown name is a usage error
+/// naming the flag and listing the accepted names. The option keeps the name the user gave, so
+/// the echoed configuration shows names; the default shown is `toString(*target)`.
 template <class Enum>
 CLI::Option* addEnumFlag(CLI::App* command, const std::string& name, Enum* target,
-                         Enum (*parse)(const std::string&, const std::string&),
                          const std::string& description) {
+  const std::string flag = "--" + name;
   return command
       ->add_option_function<std::string>(
-          "--" + name,
-          [target, parse, name](const std::string& value) { *target = parse(value, name); },
+          flag,
+          [target, flag](const std::string& value) {
+            *target = parseEnumName<Enum>(value, "flag", flag);
+          },
           description)
       ->check(CLI::Validator(
-          [parse, name](std::string& value) -> std::string {
+          [flag](std::string& value) -> std::string {
             try {
-              parse(value, name);
+              parseEnumName<Enum>(value, "flag", flag);
               return "";
             } catch (const InvalidOptions& e) {
               return e.what();

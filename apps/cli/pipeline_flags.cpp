@@ -36,9 +36,8 @@ OptionField boolean(const std::string& group, const std::string& field, const st
 
 template <class Enum>
 OptionField enumeration(const std::string& group, const std::string& field, const std::string& flag,
-                        Enum* target, Enum (*parse)(const std::string&, const std::string&),
-                        const std::string& description) {
-  return {group, field, [=](CLI::App* c) { addEnumFlag(c, flag, target, parse, description); },
+                        Enum* target, const std::string& description) {
+  return {group, field, [=](CLI::App* c) { addEnumFlag(c, flag, target, description); },
           [target] { return nlohmann::json(toString(*target)); }};
 }
 
@@ -188,7 +187,7 @@ OptionFields objectiveFields(CurveBundleAdjustmentOptions* b) {
              "Match only edges whose normal is within this angle of the curve's (deg)"),
       number(g, "pixel_sigma", "ba-pixel-sigma", &b->pixel_sigma,
              "Std dev of an edge residual (px)"),
-      enumeration(g, "kernel", "ba-kernel", &b->kernel, parseRobustKernelType,
+      enumeration(g, "kernel", "ba-kernel", &b->kernel,
                   "Robust kernel on edge residuals: none, huber, cauchy, tukey"),
       number(g, "kernel_width", "ba-kernel-width", &b->kernel_width, "Kernel width (sigmas)"),
       number(g, "lambda1", "ba-lambda1", &b->lambda1, "Weight of the segment-length term"),
@@ -216,10 +215,10 @@ OptionFields optimizerFields(const std::string& group, const std::string& prefix
                              const std::string& what, OptimizerOptions* o) {
   const std::string g = group + "/optimizer", p = prefix;
   return {
-      enumeration(g, "linear_solver", p + "linear-solver", &o->linear_solver, parseLinearSolver,
+      enumeration(g, "linear_solver", p + "linear-solver", &o->linear_solver,
                   what + ": linear solver (sparse_schur, dense_schur, iterative_schur, "
                          "sparse_normal_cholesky)"),
-      enumeration(g, "trust_region", p + "trust-region", &o->trust_region, parseTrustRegion,
+      enumeration(g, "trust_region", p + "trust-region", &o->trust_region,
                   what + ": levenberg_marquardt or dogleg"),
       number(g, "max_iterations", p + "max-iterations", &o->max_iterations,
              what + ": most solver iterations per solve"),
@@ -241,9 +240,9 @@ OptionFields optimizerFields(const std::string& group, const std::string& prefix
 OptionFields schedulerFields(const std::string& group, const std::string& prefix,
                              const std::string& what, SchedulerOptions* s) {
   OptionFields fields = {
-      enumeration(group, "strategy", prefix + "strategy", &s->strategy, parseStrategy,
+      enumeration(group, "strategy", prefix + "strategy", &s->strategy,
                   what + ": joint, alternating or inner_iterations"),
-      enumeration(group, "scope", prefix + "scope", &s->scope, parseScope,
+      enumeration(group, "scope", prefix + "scope", &s->scope,
                   what + ": global (all variables) or local (the last keyframes)"),
       number(group, "local_window", prefix + "local-window", &s->local_window,
              what + ": free keyframes in local scope"),

@@ -13,15 +13,13 @@
 #include <utility>
 #include <vector>
 
+#include "core/clock.h"
 #include "core/errors.h"
 
 namespace curvesfm::bench {
 
-using Clock = std::chrono::steady_clock;
-
-inline double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+using curvesfm::Clock;
+using curvesfm::secondsSince;
 
 /// Median of `samples` (mean of the middle two for an even count); 0 for none.
 inline double median(std::vector<double> samples) {

@@ -25,10 +25,6 @@ constexpr double kEdgePieceHalfLength = 0.5 * M_SQRT2;
 // ------------------------------------------------------------------------------------------------
 // Options.
 
-void require(bool ok, const char* field, double value, const char* constraint) {
-  requireOption(ok, "CorrespondenceOptions", field, value, constraint);
-}
-
 // ------------------------------------------------------------------------------------------------
 // Sampling.
 
@@ -176,6 +172,7 @@ double degrees(double radians) { return radians * kRadToDeg; }
 }  // namespace
 
 void CorrespondenceOptions::validate() const {
+  const OptionCheck require("CorrespondenceOptions");
   require(samples_per_segment >= 2 && samples_per_segment <= kMaxSamples, "samples_per_segment",
           samples_per_segment, "in [2, 65]");
   require(std::isfinite(min_depth_m) && min_depth_m >= Camera::kMinDepth, "min_depth_m",
@@ -300,22 +297,6 @@ CheckResult checkAppearance(const HsvAppearance& reference, const HsvAppearance&
   }
   const double error = appearanceError(reference, candidate, options.hue_weight);
   return {error <= options.max_appearance_error, error};
-}
-
-const char* correspondenceCheckName(CorrespondenceCheck check) {
-  switch (check) {
-    case CorrespondenceCheck::kNone:
-      return "none";
-    case CorrespondenceCheck::kDepth:
-      return "depth";
-    case CorrespondenceCheck::kEdgeDistance:
-      return "edge_distance";
-    case CorrespondenceCheck::kViewingDirection:
-      return "viewing_direction";
-    case CorrespondenceCheck::kAppearance:
-      return "appearance";
-  }
-  return "unknown";
 }
 
 CorrespondenceVerdict registerSegment(const BezierSegmentParams& segment, const KeyframeView& view,

@@ -6,6 +6,7 @@
 
 #include "core/bezier.h"
 #include "core/camera.h"
+#include "core/enum_names.h"
 #include "core/nearest_edge_field.h"
 #include "core/pose3.h"
 #include "core/segment_observation.h"
@@ -150,8 +151,16 @@ CheckResult checkAppearance(const HsvAppearance& reference, const HsvAppearance&
 /// The checks, in the order registerSegment runs them (cheapest first).
 enum class CorrespondenceCheck { kNone, kDepth, kEdgeDistance, kViewingDirection, kAppearance };
 
-/// "none", "depth", "edge_distance", "viewing_direction", "appearance".
-const char* correspondenceCheckName(CorrespondenceCheck check);
+template <>
+struct EnumNames<CorrespondenceCheck> {
+  static constexpr std::array<std::pair<CorrespondenceCheck, const char*>, 5> kNames = {{
+      {CorrespondenceCheck::kNone, "none"},
+      {CorrespondenceCheck::kDepth, "depth"},
+      {CorrespondenceCheck::kEdgeDistance, "edge_distance"},
+      {CorrespondenceCheck::kViewingDirection, "viewing_direction"},
+      {CorrespondenceCheck::kAppearance, "appearance"},
+  }};
+};
 
 /// The new keyframe as the checks see it. References: the caller keeps the objects alive.
 struct KeyframeView {

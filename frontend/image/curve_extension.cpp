@@ -9,10 +9,6 @@ namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-void require(bool ok, const char* field, double value, const char* constraint) {
-  requireOption(ok, "CurveExtensionOptions", field, value, constraint);
-}
-
 std::optional<Eigen::Vector2d> projectWorld(const Eigen::Vector3d& point_in_world,
                                             const Pose3& cam_from_world, const Camera& camera) {
   Eigen::Vector2d pixel;
@@ -65,6 +61,7 @@ std::optional<double> smoothGap(const PolyBezier& candidate, CurveEnd new_end, c
 }  // namespace
 
 void CurveExtensionOptions::validate() const {
+  const OptionCheck require("CurveExtensionOptions");
   require(std::isfinite(max_gap_px) && max_gap_px > 0.0, "max_gap_px", max_gap_px,
           "must be finite and > 0");
   require(std::isfinite(max_lateral_px) && max_lateral_px >= 0.0, "max_lateral_px", max_lateral_px,

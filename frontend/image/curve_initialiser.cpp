@@ -194,9 +194,8 @@ void CurveInitialiserOptions::validate() const {
       {"max_arm_to_chord", max_arm_to_chord, inOpenClosed(max_arm_to_chord, 0.0, 100.0),
        "in (0, 100]"},
   };
-  for (const auto& check : checks) {
-    requireOption(check.ok, "CurveInitialiserOptions", check.field, check.value, check.constraint);
-  }
+  const OptionCheck require("CurveInitialiserOptions");
+  for (const auto& check : checks) require(check.ok, check.field, check.value, check.constraint);
 }
 
 CurveInitialiser::CurveInitialiser(const CurveInitialiserOptions& options) : options_(options) {

@@ -14,13 +14,6 @@ namespace {
 constexpr int kShiftBits = 4;
 constexpr double kShiftScale = 1 << kShiftBits;
 
-void checkRange(const char* field, int value, int low, int high) {
-  if (value < low || value > high) {
-    throw InvalidOptions("CurveOverlayOptions", field, std::to_string(value),
-                         "in [" + std::to_string(low) + ", " + std::to_string(high) + "]");
-  }
-}
-
 cv::Point toFixedPoint(const Eigen::Vector2d& pixel) {
   return {cvRound(pixel.x() * kShiftScale), cvRound(pixel.y() * kShiftScale)};
 }
@@ -63,9 +56,12 @@ void drawPoints(cv::Mat* image, const PolyBezier& curve, const Camera& camera,
 }  // namespace
 
 void CurveOverlayOptions::validate() const {
-  checkRange("samples_per_segment", samples_per_segment, 1, 1000);
-  checkRange("thickness_px", thickness_px, 1, 50);
-  checkRange("point_radius_px", point_radius_px, 0, 50);
+  const OptionCheck require("CurveOverlayOptions");
+  require(samples_per_segment >= 1 && samples_per_segment <= 1000, "samples_per_segment",
+          samples_per_segment, "in [1, 1000]");
+  require(thickness_px >= 1 && thickness_px <= 50, "thickness_px", thickness_px, "in [1, 50]");
+  require(point_radius_px >= 0 && point_radius_px <= 50, "point_radius_px", point_radius_px,
+          "in [0, 50]");
 }
 
 CurveOverlayCounts drawCurves(cv::Mat* image_bgr, const std::vector<PolyBezier>& curves,

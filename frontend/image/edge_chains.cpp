@@ -308,18 +308,12 @@ void emitPieces(const std::vector<Eigen::Vector2i>& points, bool closed,
 }  // namespace
 
 void EdgeChainOptions::validate() const {
-  if (min_length_px < 2 || min_length_px > 1000000) {
-    throw InvalidOptions("EdgeChainOptions", "min_length_px", std::to_string(min_length_px),
-                         "in [2, 1e6]");
-  }
-  if (!(max_turn_deg > 0.0 && max_turn_deg <= 180.0)) {
-    throw InvalidOptions("EdgeChainOptions", "max_turn_deg", std::to_string(max_turn_deg),
-                         "in (0, 180]");
-  }
-  if (turn_window_px < 1 || turn_window_px > 1000) {
-    throw InvalidOptions("EdgeChainOptions", "turn_window_px", std::to_string(turn_window_px),
-                         "in [1, 1000]");
-  }
+  const OptionCheck require("EdgeChainOptions");
+  require(min_length_px >= 2 && min_length_px <= 1000000, "min_length_px", min_length_px,
+          "in [2, 1e6]");
+  require(max_turn_deg > 0.0 && max_turn_deg <= 180.0, "max_turn_deg", max_turn_deg, "in (0, 180]");
+  require(turn_window_px >= 1 && turn_window_px <= 1000, "turn_window_px", turn_window_px,
+          "in [1, 1000]");
 }
 
 double EdgeChain::arcLength() const {

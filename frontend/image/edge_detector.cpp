@@ -19,14 +19,6 @@ namespace {
 constexpr double kBinsPerGreyLevel = 16.0;
 constexpr int kHistogramBins = 4096;
 
-void requireInRange(const char* field, double value, double low, double high, bool open_low,
-                    const char* constraint) {
-  const bool above_low = open_low ? value > low : value >= low;
-  if (!(above_low && value <= high)) {  // Also rejects NaN.
-    throw InvalidOptions("EdgeDetectorOptions", field, std::to_string(value), constraint);
-  }
-}
-
 double sobelGain(int aperture) { return aperture == 3 ? 8.0 : 128.0; }
 
 cv::Mat toGrey(const cv::Mat& image) {
@@ -134,23 +126,26 @@ void applyMask(const cv::Mat& valid_mask, cv::Mat* edges) {
 }  // namespace
 
 void EdgeDetectorOptions::validate() const {
-  requireInRange("blur_sigma_px", blur_sigma_px, 0.0, 10.0, false, "in [0, 10]");
-  if (sobel_aperture != 3 && sobel_aperture != 5) {
-    throw InvalidOptions("EdgeDetectorOptions", "sobel_aperture", std::to_string(sobel_aperture),
-                         "must be 3 or 5");
-  }
-  requireInRange("canny_low_threshold", canny_low_threshold, 0.0, 1e6, false, "in [0, 1e6]");
-  requireInRange("canny_high_threshold", canny_high_threshold, 0.0, 1e6, false, "in [0, 1e6]");
-  if (canny_high_threshold > 0.0 && canny_low_threshold > canny_high_threshold) {
-    throw InvalidOptions(
-        "EdgeDetectorOptions", "canny_low_threshold", std::to_string(canny_low_threshold),
-        "must be <= canny_high_threshold = " + std::to_string(canny_high_threshold));
-  }
-  requireInRange("auto_noise_factor", auto_noise_factor, 0.0, 100.0, true, "in (0, 100]");
-  requireInRange("auto_max_seed_fraction", auto_max_seed_fraction, 0.0, 1.0, true, "in (0, 1]");
-  requireInRange("auto_min_high_threshold", auto_min_high_threshold, 0.0, 255.0, false,
-                 "in [0, 255]");
-  requireInRange("auto_low_ratio", auto_low_ratio, 0.0, 1.0, true, "in (0, 1]");
+  const OptionCheck require("EdgeDetectorOptions");
+  require(blur_sigma_px >= 0.0 && blur_sigma_px <= 10.0, "blur_sigma_px", blur_sigma_px,
+          "in [0, 10]");
+  require(sobel_aperture == 3 || sobel_aperture == 5, "sobel_aperture", sobel_aperture,
+          "must be 3 or 5");
+  require(canny_low_threshold >= 0.0 && canny_low_threshold <= 1e6, "canny_low_threshold",
+          canny_low_threshold, "in [0, 1e6]");
+  require(canny_high_threshold >= 0.0 && canny_high_threshold <= 1e6, "canny_high_threshold",
+          canny_high_threshold, "in [0, 1e6]");
+  require(canny_high_threshold == 0.0 || canny_low_threshold <= canny_high_threshold,
+          "canny_low_threshold", canny_low_threshold,
+          "must be <= canny_high_threshold = " + formatOptionValue(canny_high_threshold));
+  require(auto_noise_factor > 0.0 && auto_noise_factor <= 100.0, "auto_noise_factor",
+          auto_noise_factor, "in (0, 100]");
+  require(auto_max_seed_fraction > 0.0 && auto_max_seed_fraction <= 1.0, "auto_max_seed_fraction",
+          auto_max_seed_fraction, "in (0, 1]");
+  require(auto_min_high_threshold >= 0.0 && auto_min_high_threshold <= 255.0,
+          "auto_min_high_threshold", auto_min_high_threshold, "in [0, 255]");
+  require(auto_low_ratio > 0.0 && auto_low_ratio <= 1.0, "auto_low_ratio", auto_low_ratio,
+          "in (0, 1]");
 }
 
 EdgeImage detectEdges(const cv::Mat& image, const EdgeDetectorOptions& options,

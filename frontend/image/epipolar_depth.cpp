@@ -39,10 +39,6 @@ constexpr int kRankingSamples = 1024;
 // ------------------------------------------------------------------------------------------------
 // Options.
 
-void require(bool ok, const char* field, double value, const char* constraint) {
-  requireOption(ok, "EpipolarDepthOptions", field, value, constraint);
-}
-
 // Written as positive comparisons so that NaN fails.
 bool inClosed(double value, double low, double high) { return value >= low && value <= high; }
 bool inOpenClosed(double value, double low, double high) { return value > low && value <= high; }
@@ -689,6 +685,7 @@ void checkInputs(const Camera& camera, const std::vector<EdgeChain>& chains,
 }  // namespace
 
 void EpipolarDepthOptions::validate() const {
+  const OptionCheck require("EpipolarDepthOptions");
   require(std::isfinite(min_depth_m) && min_depth_m > 0.0, "min_depth_m", min_depth_m,
           "must be finite and > 0");
   require(max_depth_m > min_depth_m, "max_depth_m", max_depth_m,
@@ -726,16 +723,6 @@ void EpipolarDepthOptions::validate() const {
 
 static_assert(static_cast<int>(DepthStatus::kUnsupported) + 1 == kNumDepthStatuses,
               "kNumDepthStatuses must count every DepthStatus");
-
-const char* depthStatusName(DepthStatus status) {
-  // In the order of the enumerators.
-  static constexpr std::array<const char*, kNumDepthStatuses> kNames = {
-      "valid",       "not_searched",        "at_image_border", "no_reference",
-      "out_of_view", "edge_along_epipolar", "no_minimum",      "ambiguous",
-      "high_cost",   "high_variance",       "outlier",         "unsupported"};
-  const int index = static_cast<int>(status);
-  return index < kNumDepthStatuses ? kNames[index] : "unknown";
-}
 
 int DepthCounts::total() const {
   int sum = 0;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "core/enum_names.h"
 #include "core/pose3.h"
 #include "frontend/image/edge_chains.h"
 
@@ -110,8 +111,25 @@ enum class DepthStatus : std::uint8_t {
 };
 constexpr int kNumDepthStatuses = 12;
 
-/// Short lower-case name of a status ("valid", "edge_along_epipolar", ...), for reports.
-const char* depthStatusName(DepthStatus status);
+template <>
+struct EnumNames<DepthStatus> {
+  static constexpr std::array<std::pair<DepthStatus, const char*>, 12> kNames = {{
+      {DepthStatus::kValid, "valid"},
+      {DepthStatus::kNotSearched, "not_searched"},
+      {DepthStatus::kAtImageBorder, "at_image_border"},
+      {DepthStatus::kNoReference, "no_reference"},
+      {DepthStatus::kOutOfView, "out_of_view"},
+      {DepthStatus::kEdgeAlongEpipolar, "edge_along_epipolar"},
+      {DepthStatus::kNoMinimum, "no_minimum"},
+      {DepthStatus::kAmbiguous, "ambiguous"},
+      {DepthStatus::kHighCost, "high_cost"},
+      {DepthStatus::kHighVariance, "high_variance"},
+      {DepthStatus::kOutlier, "outlier"},
+      {DepthStatus::kUnsupported, "unsupported"},
+  }};
+};
+static_assert(EnumNames<DepthStatus>::kNames.size() == kNumDepthStatuses,
+              "every DepthStatus needs a name");
 
 /// The depth of one chain pixel.
 struct PixelDepth {

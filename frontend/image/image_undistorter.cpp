@@ -58,10 +58,9 @@ cv::Mat validRegion(const cv::Mat& map_x, const cv::Mat& map_y, int margin) {
 }  // namespace
 
 void ImageUndistorterOptions::validate() const {
-  if (valid_margin_px < 0 || valid_margin_px > 100) {
-    throw InvalidOptions("ImageUndistorterOptions", "valid_margin_px",
-                         std::to_string(valid_margin_px), "in [0, 100]");
-  }
+  const OptionCheck require("ImageUndistorterOptions");
+  require(valid_margin_px >= 0 && valid_margin_px <= 100, "valid_margin_px", valid_margin_px,
+          "in [0, 100]");
 }
 
 ImageUndistorter::ImageUndistorter(const Camera& distorted_camera,

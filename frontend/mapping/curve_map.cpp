@@ -7,15 +7,8 @@
 #include "core/errors.h"
 
 namespace curvesfm {
-namespace {
-
-void require(bool ok, const char* field, double value, const char* constraint) {
-  requireOption(ok, "CurveMapOptions", field, value, constraint);
-}
-
-}  // namespace
-
 void CurveMapOptions::validate() const {
+  const OptionCheck require("CurveMapOptions");
   require(promotion_observations >= 1 && promotion_observations <= 1000, "promotion_observations",
           promotion_observations, "in [1, 1000]");
   require(disable_window_keyframes >= 1 && disable_window_keyframes <= 1000,
@@ -26,18 +19,6 @@ void CurveMapOptions::validate() const {
           "min_keyframe_translation", min_keyframe_translation, "must be finite and >= 0");
   require(min_keyframe_rotation_deg >= 0.0 && min_keyframe_rotation_deg <= 180.0,
           "min_keyframe_rotation_deg", min_keyframe_rotation_deg, "in [0, 180]");
-}
-
-const char* curveStateName(CurveState state) {
-  switch (state) {
-    case CurveState::kTemporary:
-      return "temporary";
-    case CurveState::kGlobal:
-      return "global";
-    case CurveState::kDisabled:
-      return "disabled";
-  }
-  return "unknown";
 }
 
 SegmentHistory MapSegment::history() const {

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/bezier.h"
+#include "core/enum_names.h"
 #include "core/pose3.h"
 #include "core/segment_observation.h"
 #include "frontend/image/correspondence_checks.h"
@@ -46,8 +47,14 @@ enum class CurveState {
   kDisabled,   ///< Mostly unseen lately; out of bundle adjustment until seen again.
 };
 
-/// "temporary", "global", "disabled".
-const char* curveStateName(CurveState state);
+template <>
+struct EnumNames<CurveState> {
+  static constexpr std::array<std::pair<CurveState, const char*>, 3> kNames = {{
+      {CurveState::kTemporary, "temporary"},
+      {CurveState::kGlobal, "global"},
+      {CurveState::kDisabled, "disabled"},
+  }};
+};
 
 /// One segment's registrations and what the checks compare new views against.
 struct MapSegment {

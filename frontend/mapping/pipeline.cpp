@@ -1,7 +1,6 @@
 #include "frontend/mapping/pipeline.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -9,6 +8,7 @@
 #include <optional>
 
 #include "core/check.h"
+#include "core/clock.h"
 #include "core/errors.h"
 #include "core/nearest_edge_field.h"
 #include "factors/pose_variables.h"
@@ -16,12 +16,6 @@
 
 namespace curvesfm {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double secondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // One keyframe as the later keyframes and bundle adjustment need it.
 struct Keyframe {
@@ -143,10 +137,6 @@ void countRejection(CorrespondenceCheck failed, KeyframeStats* stats) {
   }
 }
 
-void requireDepthCandidates(int value) {
-  requireOption(value >= 1, "PipelineOptions", "depth_reference_candidates", value, ">= 1");
-}
-
 }  // namespace
 
 SchedulerOptions defaultLocalBundleAdjustmentOptions() {
@@ -171,11 +161,12 @@ void PipelineOptions::validate() const {
   local_ba.validate();
   global_ba.validate();
   tracking.validate();
-  requireDepthCandidates(depth_reference_candidates);
-  requireOption(reassociation_rounds >= 0, "PipelineOptions", "reassociation_rounds",
-                reassociation_rounds, ">= 0");
-  requireOption(std::isfinite(explained_radius_px) && explained_radius_px >= 0.0, "PipelineOptions",
-                "explained_radius_px", explained_radius_px, "must be finite and >= 0");
+  const OptionCheck require("PipelineOptions");
+  require(depth_reference_candidates >= 1, "depth_reference_candidates", depth_reference_candidates,
+          ">= 1");
+  require(reassociation_rounds >= 0, "reassociation_rounds", reassociation_rounds, ">= 0");
+  require(std::isfinite(explained_radius_px) && explained_radius_px >= 0.0, "explained_radius_px",
+          explained_radius_px, "must be finite and >= 0");
 }
 
 struct Pipeline::Impl {

@@ -246,7 +246,7 @@ TEST(Camera, InvalidIntrinsicsThrowInvalidOptionsNamingField) {
     return invalidOptionsMessage([&] { Camera camera(c); });
   };
   EXPECT_EQ(messageFor([](CameraIntrinsics& c) { c.fx = 0.0; }),
-            "InvalidOptions: CameraIntrinsics.fx = 0: must be finite and > 0");
+            "InvalidOptions: CameraIntrinsics.fx = 0: must be > 0 and finite");
   EXPECT_NE(messageFor([](CameraIntrinsics& c) { c.fy = -2.0; }).find("CameraIntrinsics.fy = -2"),
             std::string::npos);
   EXPECT_NE(messageFor([&](CameraIntrinsics& c) { c.fx = inf; }).find("CameraIntrinsics.fx = inf"),

@@ -98,10 +98,10 @@ TEST(SimilarityAlignment, DegenerateInputs) {
 
 TEST(SimilarityAlignment, KindNamesRoundTrip) {
   for (auto kind : {AlignmentKind::kSim3, AlignmentKind::kSe3, AlignmentKind::kNone}) {
-    EXPECT_EQ(parseAlignmentKind(toString(kind), "Options", "alignment"), kind);
+    EXPECT_EQ(parseEnumName<AlignmentKind>(toString(kind), "Options", "alignment"), kind);
   }
   try {
-    parseAlignmentKind("sim2", "Options", "alignment");
+    parseEnumName<AlignmentKind>("sim2", "Options", "alignment");
     FAIL() << "expected InvalidOptions";
   } catch (const InvalidOptions& e) {
     EXPECT_STREQ(e.what(),

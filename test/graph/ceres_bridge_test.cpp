@@ -86,15 +86,16 @@ ToyProblem makeToyProblem() {
   // The same point, direction and scale seen through several pose-like observations.
   for (int i = 0; i < 4; ++i) {
     const Key pose_key = poseKey(i + 1);
-    const Pose3 other = Pose3(so3::exp(Eigen::Vector3d(0.3 * i, -0.2, 0.1 * i)),
-                              Eigen::Vector3d(i, 1.0 - i, 0.5));
+    const Pose3 other =
+        Pose3(so3::exp(Eigen::Vector3d(0.3 * i, -0.2, 0.1 * i)), Eigen::Vector3d(i, 1.0 - i, 0.5));
     toy.truth.insert(pose_key, other);
     toy.graph.emplace<AllTypesFactor>(pose_key, pointKey(0), directionKey(0, 0),
                                       startLengthKey(0, 0),
                                       other * (point + scale * direction.vector()));
   }
   toy.graph.emplace<AllTypesFactor>(poseKey(0), pointKey(0), directionKey(0, 0),
-                                    startLengthKey(0, 0), pose * (point + scale * direction.vector()));
+                                    startLengthKey(0, 0),
+                                    pose * (point + scale * direction.vector()));
   toy.graph.emplace<PointPriorFactor>(pointKey(0), point);
   toy.start = toy.truth;
   toy.start.update(pointKey(0), Eigen::Vector3d(point + Eigen::Vector3d(0.2, -0.1, 0.1)));
@@ -121,13 +122,12 @@ TEST(Optimize, RecoversTheOptimumWithPosesConstant) {
   EXPECT_TRUE(summary.usable) << summary.message;
   EXPECT_LT(summary.final_cost, 1e-16);
   EXPECT_GT(summary.initial_cost, 1e-3);
-  EXPECT_LT((values.at<Eigen::Vector3d>(pointKey(0)) -
-             toy.truth.at<Eigen::Vector3d>(pointKey(0)))
-                .norm(),
-            1e-8);
-  EXPECT_LT(values.at<Direction>(directionKey(0, 0))
-                .angleTo(toy.truth.at<Direction>(directionKey(0, 0))),
-            1e-8);
+  EXPECT_LT(
+      (values.at<Eigen::Vector3d>(pointKey(0)) - toy.truth.at<Eigen::Vector3d>(pointKey(0))).norm(),
+      1e-8);
+  EXPECT_LT(
+      values.at<Direction>(directionKey(0, 0)).angleTo(toy.truth.at<Direction>(directionKey(0, 0))),
+      1e-8);
   EXPECT_NEAR(values.at<double>(startLengthKey(0, 0)), toy.truth.at<double>(startLengthKey(0, 0)),
               1e-8);
   for (int i = 0; i < 5; ++i) {
@@ -218,13 +218,11 @@ TEST(Optimize, MissingOrMistypedVariablesThrowBeforeSolving) {
   ToyProblem toy = makeToyProblem();
   Values missing = toy.start;
   missing.erase(pointKey(0));
-  EXPECT_THROW(optimize(toy.graph, &missing, ProblemConfig(), OptimizerOptions()),
-               KeyDoesNotExist);
+  EXPECT_THROW(optimize(toy.graph, &missing, ProblemConfig(), OptimizerOptions()), KeyDoesNotExist);
   Values mistyped = toy.start;
   mistyped.erase(startLengthKey(0, 0));
   mistyped.insert(startLengthKey(0, 0), Eigen::Vector3d::Zero());
-  EXPECT_THROW(optimize(toy.graph, &mistyped, ProblemConfig(), OptimizerOptions()),
-               IncorrectType);
+  EXPECT_THROW(optimize(toy.graph, &mistyped, ProblemConfig(), OptimizerOptions()), IncorrectType);
 }
 
 TEST(OptimizerOptions, ValidateNamesFieldAndValue) {
@@ -240,9 +238,11 @@ TEST(OptimizerOptions, ValidateNamesFieldAndValue) {
   options = OptimizerOptions();
   options.function_tolerance = -1;
   EXPECT_THROW(options.validate(), InvalidOptions);
-  EXPECT_EQ(parseLinearSolver("iterative_schur", "x"), LinearSolver::kIterativeSchur);
-  EXPECT_THROW(parseLinearSolver("cholesky", "linear_solver"), InvalidOptions);
-  EXPECT_EQ(parseTrustRegion("dogleg", "x"), TrustRegion::kDogleg);
+  EXPECT_EQ(parseEnumName<LinearSolver>("iterative_schur", "OptimizerOptions", "x"),
+            LinearSolver::kIterativeSchur);
+  EXPECT_THROW(parseEnumName<LinearSolver>("cholesky", "OptimizerOptions", "linear_solver"),
+               InvalidOptions);
+  EXPECT_EQ(parseEnumName<TrustRegion>("dogleg", "OptimizerOptions", "x"), TrustRegion::kDogleg);
 }
 
 }  // namespace

@@ -16,12 +16,9 @@ struct KernelCase {
 };
 
 std::vector<KernelCase> allKernels() {
-  return {{RobustKernelType::kNone, 1.0},
-          {RobustKernelType::kHuber, 1.0},
-          {RobustKernelType::kHuber, 2.5},
-          {RobustKernelType::kCauchy, 1.0},
-          {RobustKernelType::kCauchy, 0.3},
-          {RobustKernelType::kTukey, 1.0},
+  return {{RobustKernelType::kNone, 1.0},   {RobustKernelType::kHuber, 1.0},
+          {RobustKernelType::kHuber, 2.5},  {RobustKernelType::kCauchy, 1.0},
+          {RobustKernelType::kCauchy, 0.3}, {RobustKernelType::kTukey, 1.0},
           {RobustKernelType::kTukey, 4.0}};
 }
 
@@ -83,9 +80,10 @@ TEST(RobustKernel, RejectsNonPositiveWidthAndUnknownNames) {
   EXPECT_THROW(RobustKernel(RobustKernelType::kHuber, 0.0), InvalidOptions);
   EXPECT_THROW(RobustKernel(RobustKernelType::kCauchy, -1.0), InvalidOptions);
   EXPECT_NO_THROW(RobustKernel(RobustKernelType::kNone, 0.0));
-  EXPECT_EQ(parseRobustKernelType("cauchy", "kernel"), RobustKernelType::kCauchy);
+  EXPECT_EQ(parseEnumName<RobustKernelType>("cauchy", "RobustKernel", "kernel"),
+            RobustKernelType::kCauchy);
   try {
-    parseRobustKernelType("hubber", "kernel");
+    parseEnumName<RobustKernelType>("hubber", "RobustKernel", "kernel");
     FAIL();
   } catch (const InvalidOptions& e) {
     EXPECT_NE(std::string(e.what()).find("hubber"), std::string::npos);
@@ -95,7 +93,7 @@ TEST(RobustKernel, RejectsNonPositiveWidthAndUnknownNames) {
 
 TEST(NoiseModel, CostWhitensThenAppliesKernel) {
   const NoiseModel noise{2.0, RobustKernel(RobustKernelType::kHuber, 1.0)};
-  EXPECT_DOUBLE_EQ(noise.cost(1.0), 0.5 * 0.25);           // |r/sigma|^2 = 0.25 < 1
+  EXPECT_DOUBLE_EQ(noise.cost(1.0), 0.5 * 0.25);            // |r/sigma|^2 = 0.25 < 1
   EXPECT_DOUBLE_EQ(noise.cost(16.0), 0.5 * (2 * 2.0 - 1));  // |r/sigma| = 2 > 1
   EXPECT_THROW((NoiseModel{0.0, {}}.validate()), InvalidOptions);
 }

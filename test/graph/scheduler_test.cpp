@@ -551,14 +551,15 @@ TEST(SchedulerOptions, ValidateNamesFieldAndValue) {
 
 TEST(SchedulerOptions, ParseInvertsToString) {
   for (Strategy strategy : {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
-    EXPECT_EQ(parseStrategy(toString(strategy), "strategy"), strategy);
+    EXPECT_EQ(parseEnumName<Strategy>(toString(strategy), "SchedulerOptions", "strategy"),
+              strategy);
   }
   for (Scope scope : {Scope::kGlobal, Scope::kLocal}) {
-    EXPECT_EQ(parseScope(toString(scope), "scope"), scope);
+    EXPECT_EQ(parseEnumName<Scope>(toString(scope), "SchedulerOptions", "scope"), scope);
   }
   EXPECT_EQ(toString(Strategy::kInnerIterations), "inner_iterations");
   try {
-    parseStrategy("gauss_seidel", "strategy");
+    parseEnumName<Strategy>("gauss_seidel", "SchedulerOptions", "strategy");
     FAIL();
   } catch (const InvalidOptions& e) {
     EXPECT_NE(std::string(e.what()).find("SchedulerOptions.strategy = \"gauss_seidel\": expected "
@@ -566,7 +567,7 @@ TEST(SchedulerOptions, ParseInvertsToString) {
               std::string::npos)
         << e.what();
   }
-  EXPECT_THROW(parseScope("window", "scope"), InvalidOptions);
+  EXPECT_THROW(parseEnumName<Scope>("window", "SchedulerOptions", "scope"), InvalidOptions);
 }
 
 }  // namespace

@@ -469,20 +469,21 @@ TEST(CurveScene, NoiseKeepsTheEdgesOnTheCurves) {
 
 TEST(CurveSceneOptions, EnumNamesRoundTripAndUnknownNamesAreRejected) {
   for (const CameraPath path : {CameraPath::kOrbit, CameraPath::kForwardWalk}) {
-    EXPECT_EQ(parseCameraPath(toString(path), "camera_path"), path);
+    EXPECT_EQ(parseEnumName<CameraPath>(toString(path), "CurveSceneOptions", "camera_path"), path);
   }
   for (const CurveKind kind :
        {CurveKind::kLine, CurveKind::kArc, CurveKind::kHelix, CurveKind::kMixed}) {
-    EXPECT_EQ(parseCurveKind(toString(kind), "curve_kind"), kind);
+    EXPECT_EQ(parseEnumName<CurveKind>(toString(kind), "CurveSceneOptions", "curve_kind"), kind);
   }
   try {
-    parseCurveKind("spiral", "curve_kind");
+    parseEnumName<CurveKind>("spiral", "CurveSceneOptions", "curve_kind");
     FAIL() << "no exception";
   } catch (const InvalidOptions& e) {
     EXPECT_NE(std::string(e.what()).find("CurveSceneOptions.curve_kind"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("line, arc, helix, mixed"), std::string::npos);
   }
-  EXPECT_THROW(parseCameraPath("orbits", "camera_path"), InvalidOptions);
+  EXPECT_THROW(parseEnumName<CameraPath>("orbits", "CurveSceneOptions", "camera_path"),
+               InvalidOptions);
 }
 
 }  // namespace

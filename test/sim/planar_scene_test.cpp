@@ -314,9 +314,11 @@ TEST(PlanarScene, DriftPerturbsEveryStepAndAccumulates) {
   for (int i = 0; i < 20; ++i) early += rotation_error(i) / 20;
   for (int i = 380; i < 400; ++i) late += rotation_error(i) / 20;
   EXPECT_GT(late, 3 * early);
-  EXPECT_EQ(parseInitNoiseModel("drift", "f"), InitNoiseModel::kDrift);
+  EXPECT_EQ(parseEnumName<InitNoiseModel>("drift", "PlanarSceneOptions", "f"),
+            InitNoiseModel::kDrift);
   EXPECT_EQ(toString(InitNoiseModel::kIndependent), "independent");
-  EXPECT_THROW(parseInitNoiseModel("gaussian", "f"), InvalidOptions);
+  EXPECT_THROW(parseEnumName<InitNoiseModel>("gaussian", "PlanarSceneOptions", "f"),
+               InvalidOptions);
 }
 
 class PlanarDatasetTest : public ::testing::Test {

@@ -266,7 +266,7 @@ TEST_F(RegisterSegmentTest, StopsAtTheFirstFailedCheck) {
   history_.mean_viewing_direction_in_world = Eigen::Vector3d::UnitZ();
   const CorrespondenceVerdict recoloured = run(segmentOnEdge(), twoColourImage(kGreen, kYellow));
   EXPECT_EQ(recoloured.failed_check, CorrespondenceCheck::kAppearance);
-  EXPECT_STREQ(correspondenceCheckName(recoloured.failed_check), "appearance");
+  EXPECT_EQ(toString(recoloured.failed_check), "appearance");
 }
 
 TEST(CorrespondenceOptions, DefaultsAreValid) {

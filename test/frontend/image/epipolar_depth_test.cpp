@@ -445,11 +445,11 @@ TEST(EpipolarDepth, PixelsAtTheBorderAreRejected) {
 TEST(DepthStatus, NamesAreDistinct) {
   std::vector<std::string> names;
   for (int s = 0; s < kNumDepthStatuses; ++s) {
-    names.push_back(depthStatusName(static_cast<DepthStatus>(s)));
+    names.push_back(toString(static_cast<DepthStatus>(s)));
   }
   std::sort(names.begin(), names.end());
   EXPECT_EQ(std::unique(names.begin(), names.end()), names.end());
-  EXPECT_STREQ(depthStatusName(DepthStatus::kEdgeAlongEpipolar), "edge_along_epipolar");
+  EXPECT_EQ(toString(DepthStatus::kEdgeAlongEpipolar), "edge_along_epipolar");
 }
 
 }  // namespace

@@ -1,0 +1,103 @@
+#include "apps/plot_scripts.h"
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "core/errors.h"
+
+namespace curvesfm {
+namespace {
+
+constexpr int kCannotStart = 127;  // The shell's code for a command it could not run.
+
+std::string shellQuote(const std::string& text) {
+  if (text.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                             "_-./=:,+") == std::string::npos) {
+    return text;
+  }
+  std::string quoted = "'";
+  for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+// PYTHONPATH with the scripts folder first, so that this checkout's package wins over any other.
+std::string pythonPath() {
+  const char* existing = std::getenv("PYTHONPATH");
+  std::string path = CURVESFM_SCRIPTS_DIR;
+  if (existing && *existing) path += ":" + std::string(existing);
+  return path;
+}
+
+// fork + exec rather than system(): no shell, so paths need no quoting.
+int runPython(const std::vector<std::string>& arguments, bool quiet) {
+  std::vector<std::string> argv_strings = {CURVESFM_PYTHON};
+  argv_strings.insert(argv_strings.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (std::string& s : argv_strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  const std::string python_path = pythonPath();
+  // Our buffered output would otherwise be written twice, once by the child.
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = fork();
+  if (pid < 0) return kCannotStart;
+  if (pid == 0) {
+    setenv("PYTHONPATH", python_path.c_str(), 1);
+    if (quiet) {
+      const int null = open("/dev/null", O_WRONLY);
+      dup2(null, STDOUT_FILENO);
+      dup2(null, STDERR_FILENO);
+    }
+    execv(argv[0], argv.data());
+    _exit(kCannotStart);
+  }
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+std::string plotCommandLine(const std::vector<std::string>& arguments) {
+  std::string line = "PYTHONPATH=" + shellQuote(CURVESFM_SCRIPTS_DIR) + " " +
+                     shellQuote(CURVESFM_PYTHON) + " -m curvesfm_plots";
+  for (const std::string& argument : arguments) line += " " + shellQuote(argument);
+  return line;
+}
+
+bool plotPackageUsable() { return runPython({"-c", "import numpy, matplotlib"}, true) == 0; }
+
+int runPlotPackage(const std::vector<std::string>& arguments) {
+  std::vector<std::string> module = {"-m", "curvesfm_plots"};
+  module.insert(module.end(), arguments.begin(), arguments.end());
+  return runPython(module, false);
+}
+
+void runPlotPackageOrThrow(const std::string& what, const std::vector<std::string>& arguments) {
+  const int code = runPlotPackage(arguments);
+  if (code == 0) return;
+  const std::string reason = code == kCannotStart ? "could not start " CURVESFM_PYTHON
+                                                  : "exit code " + std::to_string(code);
+  throw Error(what + ": " + plotCommandLine(arguments) + " failed (" + reason + ")");
+}
+
+bool drawFiguresIfPossible(const std::vector<std::string>& arguments) {
+  if (!plotPackageUsable()) {
+    std::printf("figures: not drawn (%s lacks numpy or matplotlib); draw them later with: %s\n",
+                CURVESFM_PYTHON, plotCommandLine(arguments).c_str());
+    return false;
+  }
+  const int code = runPlotPackage(arguments);
+  if (code != 0) {
+    std::printf("figures: %s failed (exit code %d)\n", plotCommandLine(arguments).c_str(), code);
+  }
+  return code == 0;
+}
+
+}  // namespace curvesfm

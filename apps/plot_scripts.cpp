@@ -89,8 +89,10 @@ void runPlotPackageOrThrow(const std::string& what, const std::vector<std::strin
 
 bool drawFiguresIfPossible(const std::vector<std::string>& arguments) {
   if (!plotPackageUsable()) {
-    std::printf("figures: not drawn (%s lacks numpy or matplotlib); draw them later with: %s\n",
-                CURVESFM_PYTHON, plotCommandLine(arguments).c_str());
+    std::printf(
+        "figures: not drawn (%s did not start or lacks numpy or matplotlib); draw them later "
+        "with: %s\n",
+        CURVESFM_PYTHON, plotCommandLine(arguments).c_str());
     return false;
   }
   const int code = runPlotPackage(arguments);

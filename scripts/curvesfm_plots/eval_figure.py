@@ -4,7 +4,7 @@ Left, the top view of the ground-truth and the aligned estimated camera centres 
 largest spread, at equal scale; right, the ATE of every matched pose over time with its rmse. The
 alignment is the one curvesfm computed (per_pose.aligned_position), never redone here.
 """
-from .inputs import InputError, field, numbers, read_json
+from .inputs import NUMBER, InputError, field, numbers, read_json
 
 AXIS_NAMES = "xyz"
 
@@ -30,7 +30,7 @@ def read_evaluation(path):
     if len({len(values) for values in per_pose.values()}) != 1:
         counts = ", ".join("%s %d" % (key, len(values)) for key, values in per_pose.items())
         raise InputError("%s: the per_pose lists differ in length (%s)" % (path, counts))
-    per_pose["rmse"] = field(document, path, "ate_m.rmse", (int, float))
+    per_pose["rmse"] = field(document, path, "ate_m.rmse", NUMBER)
     per_pose["alignment"] = field(document, path, "options.alignment", str)
     return per_pose
 

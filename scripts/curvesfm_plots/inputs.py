@@ -6,6 +6,10 @@ import math
 import os
 
 
+NUMBER = (int, float)
+KIND_NAMES = {list: "a list", dict: "an object", str: "a string", NUMBER: "a number"}
+
+
 class InputError(Exception):
     """A missing or malformed input file, or a missing dependency: one line for the user."""
 
@@ -32,9 +36,8 @@ def field(document, path, key_path, kind=None):
             raise InputError('%s: expected the key "%s"' % (path, key_path))
         value = value[key]
     if kind is not None and not isinstance(value, kind):
-        names = kind.__name__ if isinstance(kind, type) else "/".join(k.__name__ for k in kind)
-        raise InputError('%s: "%s" should be a %s, found %s'
-                         % (path, key_path, names, type(value).__name__))
+        raise InputError('%s: "%s" should be %s, found %s'
+                         % (path, key_path, KIND_NAMES[kind], json.dumps(value)[:40]))
     return value
 
 
@@ -44,7 +47,7 @@ def numbers(document, path, key_path, width=None):
     for i, v in enumerate(values):
         row = v if width is not None else [v]
         if (width is not None and (not isinstance(v, list) or len(v) != width)) or not all(
-                isinstance(x, (int, float)) and not isinstance(x, bool) for x in row):
+                isinstance(x, NUMBER) and not isinstance(x, bool) for x in row):
             expected = "a number" if width is None else "%d numbers" % width
             raise InputError('%s: "%s"[%d] should be %s, found %s'
                              % (path, key_path, i, expected, json.dumps(v)))

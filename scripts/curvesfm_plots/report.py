@@ -12,7 +12,7 @@ import math
 import os
 
 from .eval_figure import AXIS_NAMES, top_view_axes
-from .inputs import InputError, field, numbers, read_json, read_obj, read_tum
+from .inputs import NUMBER, InputError, field, numbers, read_json, read_obj, read_tum
 
 STAGES = ("undistort", "edges", "field", "depth", "correspondence", "initialise", "local_ba")
 THUMBNAIL_WIDTH = 240  # px: small enough that 30 keyframes stay a light page.
@@ -73,14 +73,14 @@ def optional_camera(run):
                             "drawn as points, without frusta.")
         return None
     path = run["report_path"]
-    return {key: field(run["report"], path, "camera." + key, (int, float))
+    return {key: field(run["report"], path, "camera." + key, NUMBER)
             for key in ("width", "height", "fx", "fy", "cx", "cy")}
 
 
 def optional_per_pose(run):
-    per_pose = run["report"].get("ate", {}).get("per_pose")
-    if not per_pose:
-        problem = run["report"].get("ate", {}).get("problem")
+    ate = field(run["report"], run["report_path"], "ate", dict) if "ate" in run["report"] else {}
+    if not ate.get("per_pose"):
+        problem = ate.get("problem")
         run["notes"].append("No ground truth to compare with%s: the trajectories are drawn as "
                             "estimated and the ATE is left out."
                             % (" (%s)" % problem if problem else ""))
@@ -117,9 +117,8 @@ def frustum_depth(keyframes, curves):
     steps = sorted(math.dist(a[1], b[1]) for a, b in zip(keyframes, keyframes[1:]))
     if steps and steps[len(steps) // 2] > 0:
         return steps[len(steps) // 2] / 3
-    points = [p for _, lines in curves for line in lines for p in line]
-    extent = max((max(p[a] for p in points) - min(p[a] for p in points) for a in range(3)),
-                 default=0.0) if points else 0.0
+    points = [p for _, lines in curves for line in lines for p in line] or [(0, 0, 0)]
+    extent = max(max(p[a] for p in points) - min(p[a] for p in points) for a in range(3))
     return extent / 20 or 0.05
 
 
@@ -252,7 +251,7 @@ def costs_figure(go, run):
     for when in ("initial", "final"):
         entries = [costs[when].get(t, {}) for t in types]
         values = [e.get("cost") for e in entries]
-        if not all(isinstance(c, (int, float)) for c in values):
+        if not all(isinstance(c, NUMBER) for c in values):
             raise InputError('%s: "global_ba_cost_by_type.%s" should map each factor type to '
                              "{count, cost}" % (path, when))
         traces.append(go.Bar(x=types, y=values, name=when,

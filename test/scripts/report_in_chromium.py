@@ -1,7 +1,7 @@
 """End to end: a small planar run, `curvesfm report` on it, and the page opened in headless
 Chromium. Passes when the page records no error (window errors, unhandled rejections,
 console.error: its #report-status element; uncaught exceptions in Chromium's console log) and each
-figure holds the expected number of plotly traces. Leaves a screenshot, report.png, in WORK_DIR
+figure holds the expected number of plotly traces, and one thumbnail per overlay. Leaves a screenshot, report.png, in WORK_DIR
 for a person to look at.
 
 Usage: python3 report_in_chromium.py CURVESFM WORK_DIR
@@ -52,18 +52,23 @@ def main(curvesfm, work):
          "--overlays")
     step(curvesfm, "report", out)
     page = "file://" + os.path.abspath(os.path.join(out, "report.html"))
-    browser = step(chromium, *CHROMIUM_FLAGS, "--enable-logging=stderr", "--v=0", "--dump-dom",
-                   page)
+    # A profile of its own, so that a browser someone else runs on this machine is not reused.
+    flags = CHROMIUM_FLAGS + ["--user-data-dir=" + os.path.join(work, "profile")]
+    browser = step(chromium, *flags, "--enable-logging=stderr", "--v=0", "--dump-dom", page)
     status = report_status(browser.stdout)
     uncaught = [line for line in browser.stderr.splitlines()
                 if "CONSOLE" in line and "Uncaught" in line]
-    step(chromium, *CHROMIUM_FLAGS, "--window-size=1200,2600",
+    step(chromium, *flags, "--window-size=1200,2600",
          "--screenshot=" + os.path.join(work, "report.png"), page)
     print("page: %s" % json.dumps(status))
     if status["errors"] or uncaught:
         sys.exit("console errors: %s" % (status["errors"] + uncaught))
     if status["traces"] != EXPECTED_TRACES:
         sys.exit("traces per figure: expected %s, found %s" % (EXPECTED_TRACES, status["traces"]))
+    thumbnails = browser.stdout.count('<img src="data:image/png;base64,')
+    overlays = len(os.listdir(os.path.join(out, "overlays")))
+    if thumbnails != overlays:
+        sys.exit("overlay thumbnails: expected %d, found %d" % (overlays, thumbnails))
     print("screenshot: %s" % os.path.join(work, "report.png"))
     return 0
 

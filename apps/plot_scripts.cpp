@@ -26,35 +26,47 @@ std::string shellQuote(const std::string& text) {
   return quoted + "'";
 }
 
-// PYTHONPATH with the scripts folder first, so that this checkout's package wins over any other.
-std::string pythonPath() {
+// Our environment with PYTHONPATH = the scripts folder first, so that this checkout's package
+// wins over any other.
+std::vector<std::string> childEnvironment() {
   const char* existing = std::getenv("PYTHONPATH");
-  std::string path = CURVESFM_SCRIPTS_DIR;
-  if (existing && *existing) path += ":" + std::string(existing);
-  return path;
+  std::string python_path = std::string("PYTHONPATH=") + CURVESFM_SCRIPTS_DIR;
+  if (existing && *existing) python_path += ":" + std::string(existing);
+  std::vector<std::string> environment = {python_path};
+  for (char** entry = environ; *entry; ++entry) {
+    if (std::string(*entry).rfind("PYTHONPATH=", 0) != 0) environment.push_back(*entry);
+  }
+  return environment;
 }
 
-// fork + exec rather than system(): no shell, so paths need no quoting.
+std::vector<char*> pointers(std::vector<std::string>& strings) {
+  std::vector<char*> result;
+  for (std::string& s : strings) result.push_back(s.data());
+  result.push_back(nullptr);
+  return result;
+}
+
+// fork + execve rather than system(): no shell, so paths need no quoting. Everything the child
+// needs is prepared before fork, since a multithreaded parent's child may only call
+// async-signal-safe functions (no malloc, no setenv).
 int runPython(const std::vector<std::string>& arguments, bool quiet) {
   std::vector<std::string> argv_strings = {CURVESFM_PYTHON};
   argv_strings.insert(argv_strings.end(), arguments.begin(), arguments.end());
-  std::vector<char*> argv;
-  for (std::string& s : argv_strings) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  const std::string python_path = pythonPath();
+  std::vector<std::string> environment = childEnvironment();
+  const std::vector<char*> argv = pointers(argv_strings);
+  const std::vector<char*> envp = pointers(environment);
   // Our buffered output would otherwise be written twice, once by the child.
   std::fflush(stdout);
   std::fflush(stderr);
   const pid_t pid = fork();
   if (pid < 0) return kCannotStart;
   if (pid == 0) {
-    setenv("PYTHONPATH", python_path.c_str(), 1);
     if (quiet) {
       const int null = open("/dev/null", O_WRONLY);
       dup2(null, STDOUT_FILENO);
       dup2(null, STDERR_FILENO);
     }
-    execv(argv[0], argv.data());
+    execve(argv[0], argv.data(), envp.data());
     _exit(kCannotStart);
   }
   int status = 0;

@@ -17,6 +17,7 @@ from .inputs import NUMBER, InputError, field, numbers, read_json, read_obj, rea
 STAGES = ("undistort", "edges", "field", "depth", "correspondence", "initialise", "local_ba")
 THUMBNAIL_WIDTH = 240  # px: small enough that 30 keyframes stay a light page.
 GOLDEN = 0.618033988749895  # Spreads the colours of neighbouring curve indices apart.
+FRUSTUM_DEPTH = 0.06  # Of the 3D map's largest extent.
 
 
 def build(run_dir, out_path=None):
@@ -111,17 +112,6 @@ def to_world(pose, point_in_cam):
     return tuple(sum(r[i][j] * point_in_cam[j] for j in range(3)) + t[i] for i in range(3))
 
 
-def frustum_depth(keyframes, curves):
-    """A third of the median keyframe spacing, so neighbouring frusta do not overlap; with one
-    keyframe, a twentieth of the map's extent."""
-    steps = sorted(math.dist(a[1], b[1]) for a, b in zip(keyframes, keyframes[1:]))
-    if steps and steps[len(steps) // 2] > 0:
-        return steps[len(steps) // 2] / 3
-    points = [p for _, lines in curves for line in lines for p in line] or [(0, 0, 0)]
-    extent = max(max(p[a] for p in points) - min(p[a] for p in points) for a in range(3))
-    return extent / 20 or 0.05
-
-
 def frustum_lines(pose, camera, depth):
     """Segments from the centre to the four image corners at `depth`, and the image rectangle."""
     corners = [to_world(pose, ((u - camera["cx"]) / camera["fx"] * depth,
@@ -163,9 +153,12 @@ def map_figure(go, run):
                            text=names, hoverinfo="text",
                            line=dict(color=colours, colorscale="Turbo", cmin=0, cmax=1, width=3))]
     keyframes = run["keyframes"]
+    lo, hi = view_box(run, [pose[1] for pose in keyframes])
+    size = max(h - l for l, h in zip(lo, hi)) or 1.0
     if keyframes:
         if run["camera"]:
-            depth = frustum_depth(keyframes, run["curves"])
+            # Deep enough to see at the map's scale; neighbouring frusta may overlap.
+            depth = FRUSTUM_DEPTH * size
             x, y, z = joined([line for pose in keyframes
                               for line in frustum_lines(pose, run["camera"], depth)])
             traces.append(go.Scatter3d(x=x, y=y, z=z, mode="lines", hoverinfo="skip",
@@ -177,9 +170,35 @@ def map_figure(go, run):
                                    marker=dict(size=2, color="black"),
                                    line=dict(color="black", width=2)))
     figure = go.Figure(traces)
-    figure.update_layout(scene=dict(aspectmode="data"), height=700,
+    axes = {name + "axis": dict(range=[l, h]) for name, l, h in zip("xyz", lo, hi)}
+    ratio = {name: (h - l) / size for name, l, h in zip("xyz", lo, hi)}
+    figure.update_layout(scene=dict(aspectmode="manual", aspectratio=ratio, **axes), height=700,
                          margin=dict(l=0, r=0, t=30, b=0))
     return figure
+
+
+def view_box(run, centres):
+    """Axis ranges around the 2nd to 98th percentile of the curve samples and every camera centre:
+    a few stray curves metres away would otherwise shrink the map to a dot. Notes how many curves
+    reach beyond it."""
+    import numpy
+    samples = numpy.array([p for _, lines in run["curves"] for line in lines for p in line]
+                          or [(0.0, 0.0, 0.0)])
+    lo = numpy.percentile(samples, 2, axis=0)
+    hi = numpy.percentile(samples, 98, axis=0)
+    if centres:
+        lo = numpy.minimum(lo, numpy.min(centres, axis=0))
+        hi = numpy.maximum(hi, numpy.max(centres, axis=0))
+    pad = 0.05 * max(hi - lo) or 0.05
+    lo, hi = lo - pad, hi + pad
+    outside = sum(1 for _, lines in run["curves"]
+                  if any(not all(l <= c <= h for c, l, h in zip(p, lo, hi))
+                         for line in lines for p in line))
+    if outside:
+        run["notes"].append("%d of %d curves reach beyond the box the 3D map shows (the 2nd to "
+                            "98th percentile of the samples and the cameras); zoom out to see "
+                            "them." % (outside, len(run["curves"])))
+    return lo.tolist(), hi.tolist()
 
 
 def trajectory_figure(go, run):

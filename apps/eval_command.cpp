@@ -1,18 +1,25 @@
 #include "apps/eval_command.h"
 
+#include <stdlib.h>
+#include <unistd.h>
+
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "apps/cli/cli_options.h"
+#include "apps/cli/plot_scripts.h"
 #include "apps/cli/report_json.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
-#include "core/trajectory_plot.h"
 
 namespace curvesfm {
 namespace {
@@ -83,7 +90,43 @@ nlohmann::json perPoseToJson(const TrajectoryEvaluation& e) {
     poses["ground_truth_timestamp"].push_back(m.ground_truth_timestamp);
     poses["ate_m"].push_back(m.position_error);
   }
+  // The figure draws these as they are, so that Python never repeats the alignment.
+  const nlohmann::json positions = matchedPosesToJson(e);
+  poses["aligned_position"] = positions["aligned_position"];
+  poses["ground_truth_position"] = positions["ground_truth_position"];
   return poses;
+}
+
+// A new empty file in the temporary folder, removed with this object.
+class TemporaryFile {
+ public:
+  TemporaryFile(const std::string& prefix, const std::string& suffix) {
+    std::string pattern =
+        (std::filesystem::temp_directory_path() / (prefix + "XXXXXX" + suffix)).string();
+    const int fd = mkstemps(pattern.data(), static_cast<int>(suffix.size()));
+    if (fd < 0) throw IoError(pattern, "cannot create a temporary file");
+    close(fd);
+    path_ = pattern;
+  }
+  ~TemporaryFile() {
+    std::error_code ignored;
+    std::filesystem::remove(path_, ignored);
+  }
+  TemporaryFile(const TemporaryFile&) = delete;
+  TemporaryFile& operator=(const TemporaryFile&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// The figure's format follows the extension, and the package writes only these two.
+std::string checkPlotExtension(std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (extension == ".png" || extension == ".pdf") return "";
+  return "'" + path + "': expected a file name ending in .png or .pdf";
 }
 
 }  // namespace
@@ -117,7 +160,9 @@ EvalCommand::EvalCommand(CLI::App* app) {
   c->add_option("--json", json_path_,
                 "Write all figures, the alignment, per-pose errors and the options as JSON");
   c->add_option("--plot", plot_path_,
-                "Write a PNG: top view of both trajectories (left) and the ATE over time (right)");
+                "Draw a PNG or PDF (by extension): top view of both trajectories (left) and the "
+                "ATE over time (right), with python3 -m curvesfm_plots eval")
+      ->check(CLI::Validator(checkPlotExtension, "FILE.png|FILE.pdf"));
 }
 
 int EvalCommand::run() const {
@@ -129,9 +174,16 @@ int EvalCommand::run() const {
   printSummary(evaluation);
   printStatistics(evaluation);
 
-  if (!json_path_.empty()) {
+  // The figure is drawn from the JSON, so --plot writes it too, to a temporary file without --json.
+  std::optional<TemporaryFile> temporary_json;
+  std::string json_path = json_path_;
+  if (json_path.empty() && !plot_path_.empty()) {
+    temporary_json.emplace("curvesfm_eval_", ".json");
+    json_path = temporary_json->path();
+  }
+  if (!json_path.empty()) {
     writeJsonFile(
-        json_path_,
+        json_path,
         {{"command", "eval"},
          {"config", optionsToJson(*command_)},
          {"estimate", {{"path", estimate_path_}, {"poses", evaluation.estimate_poses}}},
@@ -149,11 +201,11 @@ int EvalCommand::run() const {
          {"per_rpe_pair",
           {{"translation_m", evaluation.rpe_translation},
            {"rotation_deg", evaluation.rpe_rotation_deg}}}});
-    std::printf("json: %s\n", json_path_.c_str());
+    if (!temporary_json) std::printf("json: %s\n", json_path.c_str());
   }
   if (!plot_path_.empty()) {
-    saveTrajectoryEvaluationPlot(plot_path_, evaluation);
-    std::printf("plot: %s\n", plot_path_.c_str());
+    // The package prints "plot: FILE" itself.
+    runPlotPackageOrThrow("eval --plot", {"eval", json_path, plot_path_});
   }
   return 0;
 }

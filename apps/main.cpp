@@ -8,6 +8,7 @@
 #include "apps/curve_ba_command.h"
 #include "apps/eval_command.h"
 #include "apps/point_ba_command.h"
+#include "apps/report_command.h"
 #include "apps/run_command.h"
 #include "apps/synth_command.h"
 #include "core/errors.h"
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   curvesfm::EvalCommand eval(&app);
   curvesfm::SynthCommand synth(&app);
   curvesfm::RunCommand run(&app);
+  curvesfm::ReportCommand report(&app);
 
   try {
     curvesfm::parseCommandLine(&app, std::vector<std::string>(argv + 1, argv + argc));
@@ -47,6 +49,7 @@ int main(int argc, char** argv) {
     if (eval.selected()) return eval.run();
     if (synth.selected()) return synth.run();
     if (run.selected()) return run.run();
+    if (report.selected()) return report.run();
   } catch (const curvesfm::Error& e) {
     std::cerr << e.what() << "\n";
     return 1;

@@ -158,10 +158,22 @@ nlohmann::json ateToJson(const AteResult& ate) {
             {"std", s.std},       {"min", s.min},
             {"max", s.max},       {"scale", e->ground_truth_from_estimate.scale}};
   };
+  nlohmann::json per_pose = nullptr;
+  if (ate.initial && ate.refined) {
+    per_pose = {{"initial", matchedPosesToJson(*ate.initial)},
+                {"refined", matchedPosesToJson(*ate.refined)}};
+  }
   return {{"alignment", "sim3"},
           {"initial_m", stats(ate.initial)},
           {"refined_m", stats(ate.refined)},
+          {"per_pose", per_pose},
           {"problem", ate.problem}};
+}
+
+// The pinhole camera of the undistorted keyframes (the report draws their frusta with it).
+nlohmann::json cameraToJson(const Camera& camera) {
+  return {{"width", camera.width()}, {"height", camera.height()}, {"fx", camera.fx()},
+          {"fy", camera.fy()},       {"cx", camera.cx()},         {"cy", camera.cy()}};
 }
 
 void writeConfigYaml(const std::string& path, const CLI::App& command) {
@@ -270,8 +282,9 @@ RunCommand::RunCommand(CLI::App* app) {
   command_ = app->add_subcommand(
       "run",
       "Curve structure from motion on a TUM RGB-D layout dataset (rgb.txt, camera.yaml, initial "
-      "poses): writes trajectory.txt, curves.ply, curves.obj, report.json, config.yaml and, with "
-      "--overlays, the curves drawn on each keyframe.");
+      "poses): writes trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, report.json, "
+      "config.yaml and, with --overlays, the curves drawn on each keyframe; `curvesfm report` "
+      "draws them.");
   addConfigFlag(command_);
   CLI::App* c = command_;
   c->add_option("--dataset", dataset_dir_,
@@ -330,6 +343,8 @@ int RunCommand::run() const {
 
   writeTrajectory(joinPath(out_dir_, "trajectory.txt"),
                   stampedPoses(result.keyframe_timestamps, result.keyframe_cam_from_world));
+  writeTrajectory(joinPath(out_dir_, "trajectory_initial.txt"),
+                  stampedPoses(result.keyframe_timestamps, result.keyframe_initial_cam_from_world));
   writeCurvesPly(joinPath(out_dir_, "curves.ply"), result.curves, export_samples_per_segment_);
   writeCurvesObj(joinPath(out_dir_, "curves.obj"), result.curves, export_samples_per_segment_);
   writeConfigYaml(joinPath(out_dir_, "config.yaml"), *command_);
@@ -355,6 +370,7 @@ int RunCommand::run() const {
                    {"groundtruth", d.ground_truth_path},
                    {"images", d.images},
                    {"frames_with_initial_pose", d.frames.size()}}},
+                 {"camera", cameraToJson(pipeline.undistortedCamera())},
                  {"counts",
                   {{"frames", d.frames.size()},
                    {"keyframes", result.keyframe_cam_from_world.size()},
@@ -373,8 +389,10 @@ int RunCommand::run() const {
 
   printSummary(d, result, seconds);
   printAte(ate, d.ground_truth_path);
-  std::printf("written: %s (trajectory.txt, curves.ply, curves.obj, report.json, config.yaml%s)\n",
-              out_dir_.c_str(), overlays_ ? ", overlays/" : "");
+  std::printf(
+      "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, report.json, "
+      "config.yaml%s)\n",
+      out_dir_.c_str(), overlays_ ? ", overlays/" : "");
   if (result.curves.empty()) {
     std::fprintf(stderr,
                  "run: no curve reached the global map: nothing was reconstructed (see "

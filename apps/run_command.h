@@ -11,7 +11,9 @@ namespace curvesfm {
 /// `curvesfm run`: the incremental curve SfM pipeline on a dataset in the TUM RGB-D layout
 /// (DESIGN.md "Data contracts"): loads camera.yaml, rgb.txt and the initial poses, feeds the
 /// frames to Pipeline printing one line per keyframe, runs global BA and writes trajectory.txt,
-/// curves.ply, curves.obj, report.json, config.yaml (the flags in force, for --config) and, with
+/// trajectory_initial.txt (the keyframes' initial poses), curves.ply, curves.obj, report.json
+/// (incl. the undistorted camera and the per-pose ATE that `curvesfm report` draws), config.yaml
+/// (the flags in force, for --config) and, with
 /// --overlays, the curves reprojected onto each keyframe. With DIR/groundtruth.txt it prints the
 /// ATE (Sim(3)) of the initial and the refined keyframe trajectory. Every PipelineOptions field
 /// is a flag (and so a --config key), prefixed by its stage.

@@ -15,10 +15,11 @@
 // photo at all is an error (exit 1). A case whose pipeline throws is recorded as failed (its
 // message in the table and CSV) and counts as not improved.
 //
-// Writes into --out: runs.csv (one row per case, per-stage timings included), summary.md (the
-// table, the paper's Table 2 beside ours, stage timings), config.yaml (every flag in force, for
-// --config), ate_ratio_vs_noise.png and ate_vs_noise.png. Prints the table and `key: value`
-// headline lines; progress on stderr.
+// Writes into --out: runs.csv (one row per case, per-stage timings included), paper_table2.csv
+// (the paper's figures), summary.md (the table, the paper's Table 2 beside ours, stage timings),
+// config.yaml (every flag in force, for --config), and through `python3 -m curvesfm_plots
+// planar-bench` (when matplotlib is there) ate_ratio_vs_noise.{png,pdf} and
+// ate_vs_noise.{png,pdf}. Prints the table and `key: value` headline lines; progress on stderr.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
@@ -41,9 +42,9 @@
 #include "apps/cli/cli_options.h"
 #include "apps/cli/config_file.h"
 #include "apps/cli/pipeline_flags.h"
+#include "apps/cli/plot_scripts.h"
 #include "benchmarks/support/bench_common.h"
 #include "core/errors.h"
-#include "core/plot.h"
 #include "core/trajectory_evaluation.h"
 #include "frontend/mapping/pipeline.h"
 #include "sim/planar_scene.h"
@@ -63,7 +64,6 @@ const std::vector<Photo> kPhotos = {
     {"opencv-logo.png", "logo"}, {"LinuxLogo.jpg", "logo"},      {"WindowsLogo.jpg", "logo"},
     {"left01.jpg", "indoor"},    {"rubberwhale1.png", "indoor"}, {"box_in_scene.png", "indoor"},
     {"building.jpg", "outdoor"}, {"leuvenA.jpg", "outdoor"},     {"graf1.png", "outdoor"}};
-const std::vector<std::string> kCategories = {"logo", "indoor", "outdoor"};
 const std::vector<int> kNoisePercents = {0, 5, 10, 15, 20};
 
 // The paper's Table 2 ("average position error of our method", converted from m to mm): rows
@@ -334,69 +334,17 @@ void writeSummary(const std::vector<CaseResult>& results, const BenchOptions& op
       << stageTable(results);
 }
 
-// One series per category of categoryMean(value) over the noise levels.
-void addCategorySeries(Plot* plot, const std::vector<CaseResult>& results,
-                       double (*value)(const CaseResult&), const std::string& suffix) {
-  for (const std::string& category : kCategories) {
-    PlotSeries series;
-    series.label = category + suffix;
-    for (int noise : kNoisePercents) {
-      series.x.push_back(noise);
-      series.y.push_back(categoryMean(results, category, noise, value));
+// The paper's Table 2 as data beside runs.csv, for the figure that sets ours against it.
+void writePaperTable(const std::filesystem::path& path) {
+  std::ofstream out(path);
+  if (!out) throw IoError(path.string(), "cannot open for writing");
+  out << "category,noise_percent,ate_mm\n";
+  const std::vector<std::string> rows = {"logo", "indoor", "outdoor", "overall"};
+  for (std::size_t row = 0; row < rows.size(); ++row) {
+    for (std::size_t col = 0; col < kNoisePercents.size(); ++col) {
+      out << rows[row] << "," << kNoisePercents[col] << "," << kPaperTable2Mm[row][col] << "\n";
     }
-    plot->add(series);
   }
-}
-
-void plotRatio(const std::vector<CaseResult>& results, const std::filesystem::path& path) {
-  PlotOptions options;
-  options.title = "Planar experiment: refined / initial ATE (mean per category)";
-  options.x_label = "intensity noise (% of 255)";
-  options.y_label = "refined ATE / initial ATE";
-  Plot plot(options);
-  addCategorySeries(
-      &plot, results, [](const CaseResult& r) { return r.ratio(); }, "");
-  PlotSeries one;
-  one.label = "no improvement";
-  one.x = {0.0, 20.0};
-  one.y = {1.0, 1.0};
-  one.style = PlotSeries::Style::kLine;
-  one.color = cv::Scalar(128, 128, 128);
-  one.line_width = 1.0;
-  plot.add(one);
-  plot.save(path.string());
-}
-
-void plotAgainstPaper(const std::vector<CaseResult>& results, const std::filesystem::path& path) {
-  PlotOptions options;
-  options.title = "Planar experiment: refined ATE vs the paper's Table 2";
-  options.x_label = "intensity noise (% of 255)";
-  options.y_label = "ATE (mm)";
-  options.log_y = true;
-  Plot plot(options);
-  addCategorySeries(
-      &plot, results, [](const CaseResult& r) { return r.refined_ate_mm; }, " (ours)");
-  for (std::size_t row = 0; row < kCategories.size(); ++row) {
-    PlotSeries paper;
-    paper.label = kCategories[row] + " (paper)";
-    paper.x.assign(kNoisePercents.begin(), kNoisePercents.end());
-    paper.y.assign(kPaperTable2Mm[row].begin(), kPaperTable2Mm[row].end());
-    paper.style = PlotSeries::Style::kLine;
-    paper.color = paletteColor(static_cast<int>(row));
-    paper.line_width = 1.0;
-    plot.add(paper);
-  }
-  PlotSeries initial;
-  initial.label = "initial (mean of all)";
-  for (int noise : kNoisePercents) {
-    initial.x.push_back(noise);
-    initial.y.push_back(
-        categoryMean(results, "", noise, [](const CaseResult& r) { return r.initial_ate_mm; }));
-  }
-  initial.style = PlotSeries::Style::kLine;
-  initial.color = cv::Scalar(128, 128, 128);
-  plot.add(initial);
-  plot.save(path.string());
 }
 
 void printHeadlines(const std::vector<CaseResult>& results) {
@@ -528,13 +476,15 @@ int run(const BenchOptions& options, const std::string& command, const std::stri
   writeText("# planar_bench: the options in force; rerun with --config " +
                 (out / "config.yaml").string() + "\n" + config_yaml,
             out / "config.yaml");
-  plotRatio(results, out / "ate_ratio_vs_noise.png");
-  plotAgainstPaper(results, out / "ate_vs_noise.png");
+  writePaperTable(out / "paper_table2.csv");
   std::printf("\n%s\n%s\n", casesTable(results).c_str(), table2Comparison(results).c_str());
   printHeadlines(results);
   printStageMedians(results);
   bench::print("total_seconds", bench::secondsSince(start));
-  bench::printText("outputs", (out / "{runs.csv,summary.md,config.yaml,*.png}").string());
+  bench::printText("outputs",
+                   (out / "{runs.csv,paper_table2.csv,summary.md,config.yaml}").string());
+  // The figures come last: the data above stands without them.
+  drawFiguresIfPossible({"planar-bench", out.string()});
   return 0;
 }
 

@@ -7,8 +7,9 @@
 // Then the best configuration (lowest mean ATE over the scenes) runs again with integer edge
 // positions instead of sub-pixel ones.
 //
-// Writes into --out: runs.csv (one row per run), summary.md (tables), and PNG plots:
-// error_vs_time.png, curve_error_vs_time.png, error_vs_weights.png, error_by_kernel.png.
+// Writes into --out: runs.csv (one row per run), summary.md (tables), and through
+// `python3 -m curvesfm_plots strategy-bench` (when matplotlib is there) the figures
+// error_vs_time, curve_error_vs_time, error_vs_weights and error_by_kernel (.png and .pdf).
 // Prints a `key: value` summary. Errors: ATE after Sim(3) alignment (mm), mean rotation error
 // (deg), curve error = mean distance of sampled curve points to the true curve after the same
 // alignment (mm).
@@ -25,9 +26,9 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli/plot_scripts.h"
 #include "benchmarks/support/bench_common.h"
 #include "core/errors.h"
-#include "core/plot.h"
 #include "factors/curve_bundle_adjustment.h"
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
@@ -240,93 +241,6 @@ void writeSummary(const std::vector<Aggregate>& sweep, const std::vector<Run>& e
   }
 }
 
-std::vector<Aggregate> filter(const std::vector<Aggregate>& all,
-                              const std::function<bool(const Config&)>& keep) {
-  std::vector<Aggregate> kept;
-  for (const Aggregate& a : all) {
-    if (keep(a.config)) kept.push_back(a);
-  }
-  return kept;
-}
-
-void plotErrorVsTime(const std::vector<Run>& runs, bool curve, const std::filesystem::path& path) {
-  PlotOptions options;
-  options.title = curve ? "Curve error vs time, every run" : "Pose error vs time, every run";
-  options.x_label = "solve time (s)";
-  options.y_label = curve ? "curve error after BA (mm)" : "ATE after BA (mm)";
-  options.log_x = true;
-  options.log_y = true;
-  Plot plot(options);
-  for (Strategy strategy : {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
-    PlotSeries series;
-    series.label = toString(strategy);
-    series.style = PlotSeries::Style::kMarkers;
-    series.marker_size = 6.0;
-    for (const Run& run : runs) {
-      if (run.config.strategy != strategy) continue;
-      series.x.push_back(run.seconds);
-      series.y.push_back(
-          1e3 * (curve ? run.after.curve_mean_error_aligned : run.after.position_ate_sim3));
-    }
-    plot.add(series);
-  }
-  plot.save(path.string());
-}
-
-void plotWeights(const std::vector<Aggregate>& sweep, const std::filesystem::path& path) {
-  // Joint, sparse Schur, Huber: one bar per lambda2 over lambda1 groups.
-  const auto base = filter(sweep, [](const Config& c) {
-    return c.strategy == Strategy::kJoint && c.solver == LinearSolver::kSparseSchur &&
-           c.kernel == RobustKernelType::kHuber;
-  });
-  BarChartOptions options;
-  options.title = "Curve error vs weights (joint, sparse Schur, Huber)";
-  options.x_label = "lambda1 (segment length)";
-  options.y_label = "curve error after BA (mm)";
-  options.value_labels = true;
-  BarChart chart({"lambda1 = 0", "lambda1 = 1e2", "lambda1 = 1e4"}, options);
-  for (double lambda2 : {0.0, 1.0, 10.0}) {
-    BarSeries series;
-    series.label = "lambda2 = " + std::to_string(static_cast<int>(lambda2));
-    for (double lambda1 : {0.0, 1e2, 1e4}) {
-      double value = std::nan("");
-      for (const Aggregate& a : base) {
-        if (a.config.lambda1 == lambda1 && a.config.lambda2 == lambda2) value = a.curve_mm;
-      }
-      series.values.push_back(value);
-    }
-    chart.add(series);
-  }
-  chart.save(path.string());
-}
-
-void plotKernels(const std::vector<Aggregate>& sweep, const std::filesystem::path& path) {
-  BarChartOptions options;
-  options.title = "Pose error by kernel and strategy (sparse Schur, default weights)";
-  options.x_label = "robust kernel";
-  options.y_label = "ATE after BA (mm)";
-  options.value_labels = true;
-  BarChart chart({"none", "huber", "cauchy"}, options);
-  for (Strategy strategy : {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
-    BarSeries series;
-    series.label = toString(strategy);
-    for (RobustKernelType kernel :
-         {RobustKernelType::kNone, RobustKernelType::kHuber, RobustKernelType::kCauchy}) {
-      double value = std::nan("");
-      for (const Aggregate& a : sweep) {
-        const Config& c = a.config;
-        if (c.strategy == strategy && c.kernel == kernel &&
-            c.solver == LinearSolver::kSparseSchur && c.lambda1 == 1e2 && c.lambda2 == 1.0) {
-          value = a.ate_mm;
-        }
-      }
-      series.values.push_back(value);
-    }
-    chart.add(series);
-  }
-  chart.save(path.string());
-}
-
 struct BenchOptions {
   std::string out = "bench_out/strategy";  ///< Output folder (created).
   bool quick = false;                      ///< One scene and a reduced sweep (smoke test).
@@ -371,10 +285,6 @@ int run(const BenchOptions& options) {
 
   writeCsv(runs, out / "runs.csv");
   writeSummary(sweep, edge_runs, named, out / "summary.md");
-  plotErrorVsTime(runs, false, out / "error_vs_time.png");
-  plotErrorVsTime(runs, true, out / "curve_error_vs_time.png");
-  plotWeights(sweep, out / "error_vs_weights.png");
-  plotKernels(sweep, out / "error_by_kernel.png");
 
   std::printf("# strategy_bench: %d runs on %zu scenes\n", total, scenes.size());
   double ate_before = 0.0;
@@ -390,7 +300,9 @@ int run(const BenchOptions& options) {
     bench::print(prefix + "curve_mm", a.curve_mm);
   }
   bench::print("total_seconds", bench::secondsSince(start));
-  bench::printText("outputs", (out / "{runs.csv,summary.md,*.png}").string());
+  bench::printText("outputs", (out / "{runs.csv,summary.md}").string());
+  // The figures come last: the data above stands without them.
+  drawFiguresIfPossible({"strategy-bench", out.string()});
   return 0;
 }
 

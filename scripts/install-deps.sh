@@ -12,6 +12,8 @@ PACKAGES=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   opencv-doc
+  python3 python3-numpy python3-matplotlib python3-plotly
+  chromium
 )
 
 missing=()

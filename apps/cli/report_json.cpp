@@ -94,6 +94,21 @@ nlohmann::json sampleCountsToJson(const CurveSampleCounts& counts) {
           {"total", counts.total()}};
 }
 
+nlohmann::json matchedPosesToJson(const TrajectoryEvaluation& evaluation) {
+  nlohmann::json poses = {{"timestamp", nlohmann::json::array()},
+                          {"error_m", nlohmann::json::array()},
+                          {"aligned_position", nlohmann::json::array()},
+                          {"ground_truth_position", nlohmann::json::array()}};
+  const auto xyz = [](const Eigen::Vector3d& p) { return nlohmann::json{p.x(), p.y(), p.z()}; };
+  for (const MatchedPose& m : evaluation.matches) {
+    poses["timestamp"].push_back(m.estimate_timestamp);
+    poses["error_m"].push_back(m.position_error);
+    poses["aligned_position"].push_back(xyz(m.aligned_estimate.translation()));
+    poses["ground_truth_position"].push_back(xyz(m.ground_truth.translation()));
+  }
+  return poses;
+}
+
 void writeJsonFile(const std::string& path, const nlohmann::json& json) {
   std::ofstream out(path);
   if (!(out << json.dump(2) << "\n")) throw IoError(path, "cannot write");

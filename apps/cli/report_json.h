@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/trajectory_evaluation.h"
 #include "factors/curve_reprojection_factor.h"
 #include "graph/optimizer.h"
 #include "graph/scheduler.h"
@@ -28,6 +29,12 @@ nlohmann::json scheduleReportToJson(const ScheduleReport& report);
 
 /// Where curve samples fall (CurveSampleCounts) as a JSON object with a total.
 nlohmann::json sampleCountsToJson(const CurveSampleCounts& counts);
+
+/// The matched poses of `evaluation` in match order, as {"timestamp": [...] (the estimate's, s),
+/// "error_m": [...] (ATE), "aligned_position": [[x, y, z], ...] (the aligned estimated camera
+/// centre), "ground_truth_position": [[x, y, z], ...]} in the ground truth's world (m), so that
+/// figures draw the alignment without computing it again.
+nlohmann::json matchedPosesToJson(const TrajectoryEvaluation& evaluation);
 
 /// Writes `json` (indented) to `path`; IoError naming the path if it cannot.
 void writeJsonFile(const std::string& path, const nlohmann::json& json);

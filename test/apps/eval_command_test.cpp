@@ -72,11 +72,44 @@ TEST_F(EvalCommandTest, PrintsMatchesAteAndRpeAndWritesJsonAndPlot) {
   EXPECT_EQ(report["ate_m"]["count"], 40);
   EXPECT_EQ(report["rpe_translation_m"]["count"], 39);
   EXPECT_EQ(report["per_pose"]["ate_m"].size(), 40u);
+  // The figure draws the aligned positions as they are: scale 2 maps the half-size circle onto
+  // the ground truth.
+  ASSERT_EQ(report["per_pose"]["aligned_position"].size(), 40u);
+  ASSERT_EQ(report["per_pose"]["ground_truth_position"].size(), 40u);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_NEAR(report["per_pose"]["aligned_position"][7][axis].get<double>(),
+                report["per_pose"]["ground_truth_position"][7][axis].get<double>(), 1e-4);
+  }
   EXPECT_EQ(report["config"]["max-dt"], "0.02");
 
+  // Drawn by python3 -m curvesfm_plots eval from the JSON: two 8 x 6 inch panels at 100 dpi.
   const cv::Mat plot = cv::imread(path("eval.png"));
   EXPECT_EQ(plot.cols, 1600);
   EXPECT_EQ(plot.rows, 600);
+}
+
+TEST_F(EvalCommandTest, PlotWithoutJsonWritesAPdf) {
+  const std::string gt = writeCircle("gt.txt", 20, 1.0);
+  const CommandResult result =
+      runCurvesfm("eval --est " + gt + " --gt " + gt + " --plot " + path("eval.pdf"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, ::testing::HasSubstr("plot: " + path("eval.pdf")));
+  EXPECT_THAT(result.output, ::testing::Not(::testing::HasSubstr("json:")));
+  std::ifstream pdf(path("eval.pdf"));
+  std::string magic(4, ' ');
+  pdf.read(magic.data(), 4);
+  EXPECT_EQ(magic, "%PDF");
+}
+
+TEST_F(EvalCommandTest, PlotOtherThanPngOrPdfIsAUsageErrorBeforeAnyWork) {
+  const std::string gt = writeCircle("gt.txt", 10, 1.0);
+  // The estimate does not exist: the extension is refused before any file is read.
+  const CommandResult result = runCurvesfm("eval --est " + path("missing.txt") + " --gt " + gt +
+                                           " --plot " + path("eval.jpg"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, ::testing::HasSubstr("--plot"));
+  EXPECT_THAT(result.output, ::testing::HasSubstr("expected a file name ending in .png or .pdf"));
+  EXPECT_FALSE(std::filesystem::exists(path("eval.jpg")));
 }
 
 TEST_F(EvalCommandTest, MissingFileExitsWithOneNamingIt) {

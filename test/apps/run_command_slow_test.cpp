@@ -78,6 +78,20 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   }
   EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));
   EXPECT_TRUE(report["ate"]["refined_m"].contains("rmse"));
+  // What `curvesfm report` draws: the initial keyframe poses, the undistorted camera, and the
+  // aligned positions of both trajectories beside the ground truth's.
+  EXPECT_EQ(readTrajectory(out + "/trajectory_initial.txt").size(), 6u);
+  EXPECT_EQ(report["camera"]["width"], 240);
+  EXPECT_EQ(report["camera"]["height"], 180);
+  EXPECT_NEAR(report["camera"]["fx"].get<double>(), 200.0, 1e-9);
+  for (const char* which : {"initial", "refined"}) {
+    const nlohmann::json& poses = report["ate"]["per_pose"][which];
+    EXPECT_EQ(poses["timestamp"].size(), 6u) << which;
+    EXPECT_EQ(poses["error_m"].size(), 6u) << which;
+    ASSERT_EQ(poses["aligned_position"].size(), 6u) << which;
+    EXPECT_EQ(poses["aligned_position"][0].size(), 3u) << which;
+    EXPECT_EQ(poses["ground_truth_position"].size(), 6u) << which;
+  }
 
   // config.yaml holds every flag in force: a rerun from it alone writes the same keyframes.
   const CommandResult again =

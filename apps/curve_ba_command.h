@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "apps/cli/options_table.h"
 #include "factors/curve_bundle_adjustment.h"
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
@@ -17,6 +18,8 @@ namespace curvesfm {
 class CurveBaCommand {
  public:
   explicit CurveBaCommand(CLI::App* app);
+  CurveBaCommand(const CurveBaCommand&) = delete;
+  CurveBaCommand& operator=(const CurveBaCommand&) = delete;
   bool selected() const { return command_->parsed(); }
   /// Throws InvalidOptions for an option out of range (main reports it as a usage error).
   void validate() const;
@@ -32,6 +35,7 @@ class CurveBaCommand {
   CurveSceneOptions scene_;
   CurveBundleAdjustmentOptions ba_;
   SchedulerOptions scheduler_;
+  OptionsTable table_;  ///< Rows point into the members above: the command is not copied.
   std::string report_path_;
 };
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "apps/cli/cli_options.h"
+#include "apps/cli/option_tables.h"
 #include "apps/cli/plot_scripts.h"
 #include "apps/cli/report_json.h"
 #include "core/dataset_io.h"
@@ -143,20 +144,8 @@ EvalCommand::EvalCommand(CLI::App* app) {
        "Estimated trajectory, TUM lines 'timestamp tx ty tz qx qy qz qw' (camera-to-world)")
       ->required();
   c->add_option("--gt", ground_truth_path_, "Ground-truth trajectory, same format")->required();
-  c->add_option_function<std::string>(
-       "--align",
-       [this](const std::string& name) {
-         options_.alignment =
-             parseEnumName<AlignmentKind>(name, "TrajectoryEvaluationOptions", "alignment");
-       },
-       "Alignment of the estimate onto the ground truth: sim3 (monocular), se3 (metric), none")
-      ->default_str(toString(options_.alignment));
-  c->add_option("--max-dt", options_.max_dt,
-                "Largest timestamp difference of a matched pose pair (s)")
-      ->capture_default_str();
-  c->add_option("--rpe-delta", options_.rpe_delta,
-                "RPE frame distance between the poses of a relative motion (matched poses)")
-      ->capture_default_str();
+  addTrajectoryEvaluationOptions(&table_, &options_, {"", "", "Evaluation", ""});
+  table_.addFlags(c);
   c->add_option("--json", json_path_,
                 "Write all figures, the alignment, per-pose errors and the options as JSON");
   c->add_option("--plot", plot_path_,
@@ -189,10 +178,7 @@ int EvalCommand::run() const {
          {"estimate", {{"path", estimate_path_}, {"poses", evaluation.estimate_poses}}},
          {"ground_truth", {{"path", ground_truth_path_}, {"poses", evaluation.ground_truth_poses}}},
          {"matched", evaluation.matches.size()},
-         {"options",
-          {{"alignment", toString(options_.alignment)},
-           {"max_dt_s", options_.max_dt},
-           {"rpe_delta_frames", options_.rpe_delta}}},
+         {"options", table_.toJson()},
          {"alignment", alignmentToJson(evaluation)},
          {"ate_m", statisticsToJson(evaluation.ate)},
          {"rpe_translation_m", statisticsToJson(evaluation.rpe_translation_stats)},

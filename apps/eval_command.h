@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "apps/cli/options_table.h"
 #include "core/trajectory_evaluation.h"
 
 namespace curvesfm {
@@ -14,9 +15,11 @@ namespace curvesfm {
 class EvalCommand {
  public:
   explicit EvalCommand(CLI::App* app);
+  EvalCommand(const EvalCommand&) = delete;
+  EvalCommand& operator=(const EvalCommand&) = delete;
   bool selected() const { return command_->parsed(); }
   /// Throws InvalidOptions for flag values out of range (a usage error, before any file is read).
-  void validate() const { options_.validate(); }
+  void validate() const { table_.validate(); }
   /// Runs the command; returns the process exit code. Bad files and options throw curvesfm
   /// errors (IoError, ParseError, InvalidOptions, TrajectoryEvaluationError).
   int run() const;
@@ -26,6 +29,7 @@ class EvalCommand {
   std::string estimate_path_;
   std::string ground_truth_path_;
   TrajectoryEvaluationOptions options_;
+  OptionsTable table_;  ///< Rows point into options_: the command is not copied.
   std::string json_path_;
   std::string plot_path_;
 };

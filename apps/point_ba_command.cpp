@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/cli/cli_options.h"
+#include "apps/cli/option_tables.h"
 #include "apps/cli/report_json.h"
 #include "core/errors.h"
 
@@ -37,30 +38,15 @@ PointBaCommand::PointBaCommand(CLI::App* app) {
       "point and reprojection errors before and after.");
   addConfigFlag(command_);
   CLI::App* c = command_;
-  c->add_option("--cameras", scene_.num_cameras, "Cameras on the arc")->capture_default_str();
-  c->add_option("--points", scene_.num_points, "Points in the cube")->capture_default_str();
-  c->add_option("--track-length", scene_.track_length, "Consecutive cameras seeing each point")
-      ->capture_default_str();
-  c->add_option("--pixel-noise", scene_.pixel_noise, "Pixel noise std dev (px)")
-      ->capture_default_str();
-  c->add_option("--pose-noise-trans", scene_.pose_noise_translation,
-                "Start-guess camera centre noise (m)")
-      ->capture_default_str();
-  c->add_option("--pose-noise-rot", scene_.pose_noise_rotation_deg,
-                "Start-guess rotation noise (deg)")
-      ->capture_default_str();
-  c->add_option("--point-noise", scene_.point_noise, "Start-guess point noise (m)")
-      ->capture_default_str();
-  c->add_option("--seed", scene_.seed, "Random seed")->capture_default_str();
-  addMeasurementFlags(c, &ba_);
-  addOptimizerFlags(c, &optimizer_);
+  addPointSceneOptions(&table_, &scene_, {"/scene", "", "Scene", ""});
+  addPointBundleAdjustmentOptions(&table_, &ba_, {"/bundle_adjustment", "", "Objective", ""});
+  addOptimizerOptions(&table_, &optimizer_, {"/optimizer", "", "Solver", ""});
+  table_.addFlags(c);
   c->add_option("--report", report_path_, "Write a JSON report (configuration, errors, solver)");
 }
 
 int PointBaCommand::run() const {
-  scene_.validate();
-  ba_.validate();
-  optimizer_.validate();
+  validate();
 
   const PointScene scene = makePointScene(scene_);
   std::printf("scene: %zu cameras, %zu points, %zu observations (seed %u)\n",
@@ -88,6 +74,7 @@ int PointBaCommand::run() const {
     const nlohmann::json report = {
         {"command", "point-ba"},
         {"config", optionsToJson(*command_)},
+        {"options", table_.toJson()},
         {"scene",
          {{"cameras", scene.true_cam_from_world.size()},
           {"points", scene.true_points.size()},

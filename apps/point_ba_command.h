@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "apps/cli/options_table.h"
 #include "factors/point_bundle_adjustment.h"
 #include "graph/optimizer.h"
 #include "sim/point_scene.h"
@@ -14,7 +15,11 @@ namespace curvesfm {
 class PointBaCommand {
  public:
   explicit PointBaCommand(CLI::App* app);
+  PointBaCommand(const PointBaCommand&) = delete;
+  PointBaCommand& operator=(const PointBaCommand&) = delete;
   bool selected() const { return command_->parsed(); }
+  /// Throws InvalidOptions for an option out of range (main reports it as a usage error).
+  void validate() const { table_.validate(); }
   /// Runs the command; returns the process exit code.
   int run() const;
 
@@ -23,6 +28,7 @@ class PointBaCommand {
   PointSceneOptions scene_;
   PointBundleAdjustmentOptions ba_;
   OptimizerOptions optimizer_;
+  OptionsTable table_;  ///< Rows point into the members above: the command is not copied.
   std::string report_path_;
 };
 

@@ -12,7 +12,7 @@
 
 #include "apps/cli/cli_options.h"
 #include "apps/cli/config_file.h"
-#include "apps/cli/pipeline_flags.h"
+#include "apps/cli/option_tables.h"
 #include "apps/cli/report_json.h"
 #include "core/clock.h"
 #include "core/curve_export.h"
@@ -25,12 +25,6 @@ namespace curvesfm {
 namespace {
 
 namespace fs = std::filesystem;
-
-nlohmann::json overlayOptionsToJson(const CurveOverlayOptions& o) {
-  return {{"samples_per_segment", o.samples_per_segment},
-          {"thickness_px", o.thickness_px},
-          {"point_radius_px", o.point_radius_px}};
-}
 
 std::string joinPath(const std::string& dir, const std::string& name) {
   return (fs::path(dir) / name).string();
@@ -299,30 +293,28 @@ RunCommand::RunCommand(CLI::App* app) {
       ->capture_default_str();
   c->add_flag("--overlays", overlays_,
               "Write OUT/overlays/NNNNNN.png: the final curves drawn on keyframe NNNNNN");
-  c->add_option("--overlay-samples", overlay_.samples_per_segment,
-                "Samples per segment of the overlay polylines")
-      ->capture_default_str();
-  c->add_option("--overlay-thickness", overlay_.thickness_px, "Overlay line thickness (px)")
-      ->capture_default_str();
-  c->add_option("--overlay-point-radius", overlay_.point_radius_px,
-                "Radius of the circles on the curve points Q (px); 0 draws none")
-      ->capture_default_str();
   c->add_option("--export-samples", export_samples_per_segment_,
                 "Samples per segment of the curves in curves.ply and curves.obj")
       ->capture_default_str();
-  addPipelineFlags(c, &options_);
+  addPipelineOptions(&table_, &options_, "/pipeline");
+  addCurveOverlayOptions(&table_, &overlay_, {"/overlay", "overlay-", "Overlays", ""});
+  table_.addFlags(c);
 }
 
 void RunCommand::validate() const {
-  options_.validate();
-  overlay_.validate();
-  if (export_samples_per_segment_ < 1 || export_samples_per_segment_ > 1000) {
-    throw InvalidOptions("RunCommand", "export-samples",
-                         std::to_string(export_samples_per_segment_), "in [1, 1000]");
-  }
-  if (!(max_dt_ >= 0.0 && max_dt_ < 1e6)) {
-    throw InvalidOptions("RunCommand", "max-dt", std::to_string(max_dt_), "finite and >= 0");
-  }
+  table_.validate();
+  // The run's own flags, named as the user types them.
+  const OptionCheck require("RunCommand");
+  require(export_samples_per_segment_ >= 1 && export_samples_per_segment_ <= 1000, "export-samples",
+          export_samples_per_segment_, "in [1, 1000]");
+  require(max_dt_ >= 0.0 && max_dt_ < 1e6, "max-dt", max_dt_, "finite and >= 0");
+}
+
+nlohmann::json RunCommand::runOptionsJson() const {
+  nlohmann::json options = table_.toJson();
+  options["export_samples_per_segment"] = export_samples_per_segment_;
+  options["max_dt"] = max_dt_;
+  return options;
 }
 
 int RunCommand::run() const {
@@ -358,10 +350,7 @@ int RunCommand::run() const {
   writeJsonFile(joinPath(out_dir_, "report.json"),
                 {{"command", "run"},
                  {"config", optionsToJson(*command_)},
-                 {"options",
-                  {{"pipeline", pipelineOptionsToJson(options_)},
-                   {"overlay", overlayOptionsToJson(overlay_)},
-                   {"export_samples_per_segment", export_samples_per_segment_}}},
+                 {"options", runOptionsJson()},
                  {"dataset",
                   {{"dir", dataset_dir_},
                    {"camera", d.camera_path},

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "apps/cli/options_table.h"
 #include "frontend/image/curve_overlay.h"
 #include "frontend/mapping/pipeline.h"
 
@@ -20,6 +21,8 @@ namespace curvesfm {
 class RunCommand {
  public:
   explicit RunCommand(CLI::App* app);
+  RunCommand(const RunCommand&) = delete;
+  RunCommand& operator=(const RunCommand&) = delete;
   bool selected() const { return command_->parsed(); }
   /// Throws InvalidOptions for an option out of range (main reports it as a usage error).
   void validate() const;
@@ -28,6 +31,9 @@ class RunCommand {
   int run() const;
 
  private:
+  /// Every option in force, for report.json: the table's and the run's own.
+  nlohmann::json runOptionsJson() const;
+
   CLI::App* command_;
   std::string dataset_dir_;
   std::string out_dir_;
@@ -38,6 +44,7 @@ class RunCommand {
   double max_dt_ = 0.02;
   PipelineOptions options_;
   CurveOverlayOptions overlay_;
+  OptionsTable table_;  ///< Rows point into options_ and overlay_: the command is not copied.
 };
 
 }  // namespace curvesfm

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "apps/cli/cli_options.h"
+#include "apps/cli/option_tables.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
 
@@ -63,39 +64,8 @@ SynthCommand::SynthCommand(CLI::App* app) {
   c->add_option("--out", out_dir_, "Dataset folder to write (created if needed)")
       ->required()
       ->check(kNotEmpty);
-  c->add_option("--frames", options_.num_frames, "Views along the orbit arc")
-      ->capture_default_str();
-  c->add_option("--noise", options_.intensity_noise,
-                "P: std dev of the per-pixel, per-channel intensity noise as a fraction of 255 "
-                "(0.05 = 5%)")
-      ->capture_default_str();
-  c->add_option("--seed", options_.seed, "Random seed of the noise and the initial poses")
-      ->capture_default_str();
-  addEnumFlag(c, "init-noise-model", &options_.init_noise_model,
-              "Initial poses: independent (every pose perturbed on its own) or drift (every "
-              "motion between consecutive frames perturbed, errors accumulate as in visual "
-              "odometry)");
-  c->add_option("--init-noise-trans", options_.init_noise_translation,
-                "Initial poses: std dev per axis of the camera-centre error (m), per pose or, "
-                "with drift, per step")
-      ->capture_default_str();
-  c->add_option("--init-noise-rot", options_.init_noise_rotation_deg,
-                "Initial poses: std dev per axis of the rotation error (deg), per pose or, with "
-                "drift, per step")
-      ->capture_default_str();
-  c->add_option("--width", options_.width, "Image width (px); the principal point is centred")
-      ->capture_default_str();
-  c->add_option("--height", options_.height, "Image height (px)")->capture_default_str();
-  c->add_option("--plane-width", options_.plane_width,
-                "Extent of the photo's longer side on the plane (m)")
-      ->capture_default_str();
-  c->add_option("--orbit-radius", options_.orbit_radius,
-                "Horizontal distance of the cameras from the plane centre (m)")
-      ->capture_default_str();
-  c->add_option("--camera-height", options_.camera_height, "Height of the orbit (m)")
-      ->capture_default_str();
-  c->add_option("--arc", options_.arc_degrees, "Orbit arc spanned by the views (deg)")
-      ->capture_default_str();
+  addPlanarSceneOptions(&table_, &options_, {"", "", "Scene", ""});
+  table_.addFlags(c);
 }
 
 PlanarSceneOptions SynthCommand::planarOptions() const {
@@ -105,7 +75,10 @@ PlanarSceneOptions SynthCommand::planarOptions() const {
   return options;
 }
 
-void SynthCommand::validate() const { planarOptions().validate(); }
+void SynthCommand::validate() const {
+  table_.validate();
+  planarOptions().validate();
+}
 
 int SynthCommand::run() const {
   const PlanarSceneOptions options = planarOptions();

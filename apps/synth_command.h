@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "apps/cli/options_table.h"
 #include "sim/planar_scene.h"
 
 namespace curvesfm {
@@ -14,6 +15,8 @@ namespace curvesfm {
 class SynthCommand {
  public:
   explicit SynthCommand(CLI::App* app);
+  SynthCommand(const SynthCommand&) = delete;
+  SynthCommand& operator=(const SynthCommand&) = delete;
   bool selected() const { return planar_->parsed(); }
   /// Throws InvalidOptions for an option out of range (main reports it as a usage error).
   void validate() const;
@@ -28,6 +31,7 @@ class SynthCommand {
 
   CLI::App* planar_;
   PlanarSceneOptions options_;
+  OptionsTable table_;  ///< Rows point into options_: the command is not copied.
   std::string image_path_;
   std::string out_dir_;
 };

@@ -41,7 +41,7 @@
 
 #include "apps/cli/cli_options.h"
 #include "apps/cli/config_file.h"
-#include "apps/cli/pipeline_flags.h"
+#include "apps/cli/option_tables.h"
 #include "apps/cli/plot_scripts.h"
 #include "benchmarks/support/bench_common.h"
 #include "core/errors.h"
@@ -542,7 +542,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
   curvesfm::addConfigFlag(&app);
-  curvesfm::addPipelineFlags(&app, &options.pipeline);
+  curvesfm::OptionsTable table;
+  curvesfm::addPipelineOptions(&table, &options.pipeline, "/pipeline");
+  table.addFlags(&app);
   const std::string command = curvesfm::commandLine(argc, argv);
   const auto parse = [&] {
     curvesfm::parseCommandLine(&app, std::vector<std::string>(argv + 1, argv + argc));
@@ -553,7 +555,7 @@ int main(int argc, char** argv) {
       options.noise_percents = {0, 10};
       options.frames = std::min(options.frames, 10);
     }
-    options.pipeline.validate();
+    table.validate();
     return curvesfm::run(options, command, curvesfm::effectiveOptionsYaml(app));
   });
 }

@@ -18,7 +18,24 @@ ParseError::ParseError(const std::string& path, int line, const std::string& exp
 
 InvalidOptions::InvalidOptions(const std::string& struct_name, const std::string& field,
                                const std::string& value, const std::string& constraint)
-    : Error("InvalidOptions: " + struct_name + "." + field + " = " + value + ": " + constraint) {}
+    : InvalidOptions(
+          "InvalidOptions: " + struct_name + "." + field + " = " + value + ": " + constraint,
+          struct_name, field, value, constraint) {}
+
+InvalidOptions::InvalidOptions(const std::string& message, const std::string& struct_name,
+                               const std::string& field, const std::string& value,
+                               const std::string& constraint)
+    : Error(message),
+      struct_name_(struct_name),
+      field_(field),
+      value_(value),
+      constraint_(constraint) {}
+
+InvalidOptions InvalidOptions::withFlag(const std::string& flag) const {
+  return InvalidOptions("InvalidOptions: --" + flag + " = " + value_ + ": " + constraint_ + " (" +
+                            struct_name_ + "." + field_ + ")",
+                        struct_name_, field_, value_, constraint_);
+}
 
 std::string formatOptionValue(double value) {
   std::ostringstream out;

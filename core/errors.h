@@ -34,11 +34,24 @@ class ParseError : public Error {
 };
 
 /// An options struct holds a value outside its documented range.
-/// Message: "InvalidOptions: <Struct>.<field> = <value>: <constraint>".
+/// Message: "InvalidOptions: <Struct>.<field> = <value>: <constraint>", or, once the command line
+/// knows which flag set the field (withFlag), "InvalidOptions: --<flag> = <value>: <constraint>
+/// (<Struct>.<field>)".
 class InvalidOptions : public Error {
  public:
   InvalidOptions(const std::string& struct_name, const std::string& field, const std::string& value,
                  const std::string& constraint);
+
+  const std::string& structName() const { return struct_name_; }
+  const std::string& field() const { return field_; }
+  /// The same error worded for the user who typed `--flag` (given without dashes).
+  InvalidOptions withFlag(const std::string& flag) const;
+
+ private:
+  InvalidOptions(const std::string& message, const std::string& struct_name,
+                 const std::string& field, const std::string& value, const std::string& constraint);
+
+  std::string struct_name_, field_, value_, constraint_;
 };
 
 /// A number as options messages print it (shortest round-trip-ish form, C locale).

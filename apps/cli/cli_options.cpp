@@ -59,57 +59,6 @@ CLI::Option* addBoolFlag(CLI::App* command, const std::string& name, bool* targe
       ->default_str(*target ? "true" : "false");
 }
 
-void addOptimizerFlags(CLI::App* command, OptimizerOptions* options) {
-  addEnumFlag(command, "linear-solver", &options->linear_solver,
-              "Linear solver of each step: sparse_schur, dense_schur, iterative_schur, "
-              "sparse_normal_cholesky");
-  addEnumFlag(command, "trust-region", &options->trust_region,
-              "Trust-region strategy: levenberg_marquardt, dogleg");
-  command->add_option("--max-iterations", options->max_iterations, "Maximum solver iterations")
-      ->capture_default_str();
-  command->add_option("--threads", options->num_threads, "Solver threads")->capture_default_str();
-  command
-      ->add_option("--function-tolerance", options->function_tolerance,
-                   "Stop when the relative cost change falls below this")
-      ->capture_default_str();
-  command
-      ->add_option("--gradient-tolerance", options->gradient_tolerance,
-                   "Stop when the max gradient falls below this")
-      ->capture_default_str();
-  command
-      ->add_option("--parameter-tolerance", options->parameter_tolerance,
-                   "Stop when the relative step falls below this")
-      ->capture_default_str();
-  command->add_flag("!--no-structure-first", options->structure_first_ordering,
-                    "Let Ceres choose the Schur elimination order");
-  command->add_flag("--inner-iterations", options->use_inner_iterations,
-                    "Use Ceres inner iterations");
-  command->add_flag("--verbose", options->verbose, "Print the solver's per-iteration log");
-}
-
-CLI::Option* addKernelFlag(CLI::App* command, const std::string& name, RobustKernelType* kernel,
-                           const std::string& description) {
-  return addEnumFlag(command, name, kernel, description + ": none, huber, cauchy, tukey");
-}
-
-void addSchedulerFlags(CLI::App* command, SchedulerOptions* options) {
-  addEnumFlag(command, "strategy", &options->strategy,
-              "How the free variables are split into solves: joint, alternating (poses, then "
-              "structure, per round), inner_iterations");
-  addEnumFlag(command, "scope", &options->scope,
-              "Free variables: global (all), local (the last --local-window cameras and the "
-              "structure they see)");
-  command->add_option("--local-window", options->local_window, "Free cameras in local scope")
-      ->capture_default_str();
-  command->add_option("--max-rounds", options->max_rounds, "Alternating: most rounds")
-      ->capture_default_str();
-  command
-      ->add_option("--round-tolerance", options->round_tolerance,
-                   "Alternating: stop when a round lowers the cost by less than this fraction")
-      ->capture_default_str();
-  addOptimizerFlags(command, &options->optimizer);
-}
-
 void parseCommandLine(CLI::App* app, const std::vector<std::string>& args) {
   const CLI::App* command = nullptr;
   try {

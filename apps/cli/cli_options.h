@@ -1,17 +1,12 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "core/enum_names.h"
 #include "core/errors.h"
-#include "factors/curve_reprojection_factor.h"
-#include "graph/optimizer.h"
-#include "graph/robust_kernel.h"
-#include "graph/scheduler.h"
 
 namespace curvesfm {
 
@@ -21,22 +16,19 @@ namespace curvesfm {
 template <class Enum>
 CLI::Option* addEnumFlag(CLI::App* command, const std::string& name, Enum* target,
                          const std::string& description) {
-  const std::string flag = "--" + name;
   return command
       ->add_option_function<std::string>(
-          flag,
-          [target, flag](const std::string& value) {
-            *target = parseEnumName<Enum>(value, "flag", flag);
+          "--" + name,
+          [target, name](const std::string& value) {
+            *target = parseEnumName<Enum>(value, "flag", name);
           },
           description)
       ->check(CLI::Validator(
-          [flag](std::string& value) -> std::string {
-            try {
-              parseEnumName<Enum>(value, "flag", flag);
-              return "";
-            } catch (const InvalidOptions& e) {
-              return e.what();
+          [](std::string& value) -> std::string {
+            for (const auto& entry : EnumNames<Enum>::kNames) {
+              if (value == entry.second) return "";
             }
+            return "\"" + value + "\": expected one of " + enumNameList<Enum>();
           },
           "NAME"))
       ->default_str(toString(*target));
@@ -46,39 +38,6 @@ CLI::Option* addEnumFlag(CLI::App* command, const std::string& name, Enum* targe
 /// switch whose default is on needs a value, since a YAML `false` cannot switch a bare flag off.
 CLI::Option* addBoolFlag(CLI::App* command, const std::string& name, bool* target,
                          const std::string& description);
-
-/// Registers the OptimizerOptions flags (--linear-solver, --trust-region, --max-iterations,
-/// --threads, --function-tolerance, ..., --verbose) on `command`, writing into `options`.
-void addOptimizerFlags(CLI::App* command, OptimizerOptions* options);
-
-/// Registers `--<name>` taking a robust kernel name (none, huber, cauchy, tukey).
-CLI::Option* addKernelFlag(CLI::App* command, const std::string& name, RobustKernelType* kernel,
-                           const std::string& description);
-
-/// Registers the measurement and gauge flags point and curve bundle adjustment share on
-/// `command`: --pixel-sigma, --kernel, --kernel-width, --fix-first-pose, --fix-scale,
-/// --scale-sigma. `Options` is PointBundleAdjustmentOptions or CurveBundleAdjustmentOptions.
-template <class Options>
-void addMeasurementFlags(CLI::App* command, Options* options) {
-  command->add_option("--pixel-sigma", options->pixel_sigma, "Std dev of an image residual (px)")
-      ->capture_default_str();
-  addKernelFlag(command, "kernel", &options->kernel, "Robust kernel on image residuals");
-  command->add_option("--kernel-width", options->kernel_width, "Kernel width (sigmas)")
-      ->capture_default_str();
-  addBoolFlag(command, "fix-first-pose", &options->fix_first_pose,
-              "Hold the first camera constant (rotation and translation gauge)");
-  addBoolFlag(command, "fix-scale", &options->fix_scale,
-              "Hold the distance between the first two cameras at its true value (scale gauge)");
-  command
-      ->add_option("--scale-sigma", options->scale_sigma,
-                   "Std dev of that distance constraint (scene units)")
-      ->capture_default_str();
-}
-
-/// Registers the SchedulerOptions flags (--strategy, --scope, --local-window, --max-rounds,
-/// --round-tolerance) and those of its OptimizerOptions on `command`. fix_first_pose is left to
-/// the caller, which holds one gauge switch for the graph builder and the scheduler.
-void addSchedulerFlags(CLI::App* command, SchedulerOptions* options);
 
 /// Parses `args` (without the program name) into `app`; if `app` itself or the selected
 /// sub-command (nested ones included, e.g. `synth planar`) got `--config FILE`, parses again with

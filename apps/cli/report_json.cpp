@@ -12,29 +12,6 @@ nlohmann::json costsToJson(const std::map<std::string, FactorTypeCost>& costs) {
   return json;
 }
 
-nlohmann::json optimizerOptionsToJson(const OptimizerOptions& options) {
-  return {{"linear_solver", toString(options.linear_solver)},
-          {"trust_region", toString(options.trust_region)},
-          {"max_iterations", options.max_iterations},
-          {"num_threads", options.num_threads},
-          {"function_tolerance", options.function_tolerance},
-          {"gradient_tolerance", options.gradient_tolerance},
-          {"parameter_tolerance", options.parameter_tolerance},
-          {"structure_first_ordering", options.structure_first_ordering},
-          {"use_inner_iterations", options.use_inner_iterations},
-          {"verbose", options.verbose}};
-}
-
-nlohmann::json schedulerOptionsToJson(const SchedulerOptions& options) {
-  return {{"strategy", toString(options.strategy)},
-          {"scope", toString(options.scope)},
-          {"local_window", options.local_window},
-          {"max_rounds", options.max_rounds},
-          {"round_tolerance", options.round_tolerance},
-          {"fix_first_pose", options.fix_first_pose},
-          {"optimizer", optimizerOptionsToJson(options.optimizer)}};
-}
-
 nlohmann::json scheduleReportToJson(const ScheduleReport& report) {
   nlohmann::json rounds = nlohmann::json::array();
   for (const ScheduleRound& round : report.rounds) {

@@ -19,10 +19,6 @@ nlohmann::json summaryToJson(const OptimizationSummary& summary);
 /// Costs per factor type as {type: {count, cost}} (for report.json).
 nlohmann::json costsToJson(const std::map<std::string, FactorTypeCost>& costs);
 
-/// Every field of the options as a JSON object, enums by name (for report.json).
-nlohmann::json optimizerOptionsToJson(const OptimizerOptions& options);
-nlohmann::json schedulerOptionsToJson(const SchedulerOptions& options);
-
 /// A ScheduleReport as a JSON object: totals, stop reason, warnings and every phase with its
 /// solver summary (for report.json).
 nlohmann::json scheduleReportToJson(const ScheduleReport& report);

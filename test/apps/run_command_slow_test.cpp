@@ -70,7 +70,7 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_EQ(report["options"]["pipeline"]["global_ba"]["optimizer"]["max_iterations"], 10);
   EXPECT_EQ(report["options"]["pipeline"]["map"]["min_keyframe_translation"], 0.0);
   EXPECT_TRUE(report["global_ba"].contains("rounds"));
-  EXPECT_EQ(report["options"]["pipeline"]["pipeline"]["reassociation_rounds"], 3);
+  EXPECT_EQ(report["options"]["pipeline"]["reassociation_rounds"], 3);
   ASSERT_TRUE(report["reassociation"].is_array());
   for (const auto& round : report["reassociation"]) {
     EXPECT_GT(round["added_observations"].get<int>(), 0);

@@ -85,17 +85,30 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   writeTinyDataset();
   CommandResult result = run("--edges-sobel-aperture 4");
   EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.output, HasSubstr("EdgeDetectorOptions.sobel_aperture = 4"));
+  // Range errors name the flag the user typed, then the field it sets.
+  EXPECT_THAT(result.output, StartsWith("InvalidOptions: --edges-sobel-aperture = 4: must be 3 or "
+                                        "5 (EdgeDetectorOptions.sobel_aperture)"));
   result = run("--reassociation-rounds -1");
   EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.output, HasSubstr("PipelineOptions.reassociation_rounds = -1"));
+  EXPECT_THAT(result.output, HasSubstr("--reassociation-rounds = -1: >= 0 "
+                                       "(PipelineOptions.reassociation_rounds)"));
   result = run("--extend-max-angle 0");
   EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.output, HasSubstr("CurveExtensionOptions.max_angle_deg = 0"));
+  EXPECT_THAT(
+      result.output,
+      HasSubstr("--extend-max-angle = 0: in (0, 180] (CurveExtensionOptions.max_angle_deg)"));
   result = run("--ba-motion-prior-translation -0.1");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output,
-              HasSubstr("CurveBundleAdjustmentOptions.motion_prior_translation_sigma_rel"));
+              HasSubstr("--ba-motion-prior-translation = -0.1: must be > 0 and finite "
+                        "(CurveBundleAdjustmentOptions.motion_prior_translation_sigma_rel)"));
+  // The same struct in two places: the error names the place's flag.
+  result = run("--global-ba-max-rounds 0");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--global-ba-max-rounds = 0"));
+  result = run("--track-max-iterations -1");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--track-max-iterations = -1"));
   result = run("--local-ba-strategy sideways");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--local-ba-strategy"));

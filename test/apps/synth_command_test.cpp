@@ -98,10 +98,12 @@ TEST_F(SynthCommandTest, BadValuesAreUsageErrorsNamingTheOption) {
   const std::string flags = "synth planar --image " + path("photo.png") + " --out " + path("d");
   CommandResult result = runCurvesfm(flags + " --noise 5");
   EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.output, HasSubstr("PlanarSceneOptions.intensity_noise = 5"));
+  EXPECT_THAT(result.output, HasSubstr("--noise = 5: must be in [0, 1] (a fraction of 255) "
+                                       "(PlanarSceneOptions.intensity_noise)"));
   result = runCurvesfm(flags + " --frames 1");
   EXPECT_EQ(result.exit_code, 2);
-  EXPECT_THAT(result.output, HasSubstr("PlanarSceneOptions.num_frames = 1"));
+  EXPECT_THAT(result.output,
+              HasSubstr("--frames = 1: must be >= 2 (PlanarSceneOptions.num_frames)"));
   result = runCurvesfm(flags + " --init-noise-model gaussian");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("expected one of independent, drift"));

@@ -1,0 +1,491 @@
+#include "apps/cli/option_tables.h"
+
+#include <cctype>
+#include <cstdio>
+#include <locale>
+#include <sstream>
+#include <vector>
+
+#include "core/errors.h"
+
+namespace curvesfm {
+namespace {
+
+// "x,y,z" for a vector flag; InvalidOptions naming `struct_name`.`field` for anything else.
+Eigen::Vector3d parseVector3(const std::string& text, const std::string& struct_name,
+                             const std::string& field) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  in.imbue(std::locale::classic());
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    try {
+      values.push_back(std::stod(item, &used));
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size()) values.clear(), values.resize(4);
+  }
+  if (values.size() != 3) {
+    throw InvalidOptions(struct_name, field, "\"" + text + "\"",
+                         "expected three numbers \"x,y,z\"");
+  }
+  return {values[0], values[1], values[2]};
+}
+
+std::string printVector3(const Eigen::Vector3d& v) {
+  return formatOptionValue(v.x()) + "," + formatOptionValue(v.y()) + "," + formatOptionValue(v.z());
+}
+
+OptionPlace stage(const std::string& path, const std::string& field, const std::string& prefix,
+                  const std::string& heading) {
+  return {path + "/" + field, prefix, heading, ""};
+}
+
+void addImageStages(OptionsTable* table, PipelineOptions* o, const std::string& path) {
+  OptionPlace u = stage(path, "undistort", "undistort-", "Undistortion");
+  table->group(&o->undistort, "ImageUndistorterOptions", u.path, u.prefix, u.heading)
+      .number("valid_margin_px", "valid-margin", &o->undistort.valid_margin_px,
+              "Band along the border of the undistorted data ignored by edge detection (px)");
+  EdgeDetectorOptions* e = &o->edges;
+  OptionPlace edges = stage(path, "edges", "edges-", "Edges");
+  table->group(e, "EdgeDetectorOptions", edges.path, edges.prefix, edges.heading)
+      .number("blur_sigma_px", "blur-sigma", &e->blur_sigma_px,
+              "Gaussian blur before differentiation (px); 0 disables it")
+      .number("sobel_aperture", "sobel-aperture", &e->sobel_aperture, "Sobel aperture: 3 or 5")
+      .number("canny_low_threshold", "canny-low", &e->canny_low_threshold,
+              "Canny low threshold (grey levels/px); 0 = auto-low-ratio x high")
+      .number("canny_high_threshold", "canny-high", &e->canny_high_threshold,
+              "Canny high threshold (grey levels/px); 0 = automatic")
+      .number("auto_noise_factor", "auto-noise-factor", &e->auto_noise_factor,
+              "Automatic high threshold in gradient noise std devs")
+      .number("auto_max_seed_fraction", "auto-max-seed-fraction", &e->auto_max_seed_fraction,
+              "Largest fraction of pixels above the automatic high threshold")
+      .number("auto_min_high_threshold", "auto-min-high", &e->auto_min_high_threshold,
+              "Floor of the automatic high threshold (grey levels/px)")
+      .number("auto_low_ratio", "auto-low-ratio", &e->auto_low_ratio,
+              "Automatic low threshold as a fraction of the high one");
+  OptionPlace c = stage(path, "chains", "chains-", "Chains");
+  table->group(&o->chains, "EdgeChainOptions", c.path, c.prefix, c.heading)
+      .number("min_length_px", "min-length", &o->chains.min_length_px,
+              "Chains with fewer pixels are dropped (px)")
+      .number("max_turn_deg", "max-turn", &o->chains.max_turn_deg,
+              "Split a chain where it turns by more than this over the turn window (deg)")
+      .number("turn_window_px", "turn-window", &o->chains.turn_window_px,
+              "Window of the turn measure (chain pixels)");
+  OptionPlace f = stage(path, "field", "field-", "Nearest-edge field");
+  table->group(&o->field, "NearestEdgeFieldOptions", f.path, f.prefix, f.heading)
+      .number("max_distance_px", "max-distance", &o->field.max_distance_px,
+              "Reach of the nearest-edge field (px)");
+}
+
+void addDepth(OptionsTable* table, EpipolarDepthOptions* d, const std::string& path) {
+  const OptionPlace p = stage(path, "depth", "depth-", "Depth");
+  table->group(d, "EpipolarDepthOptions", p.path, p.prefix, p.heading)
+      .number("min_depth_m", "min", &d->min_depth_m, "Nearest depth searched (m)")
+      .number("max_depth_m", "max", &d->max_depth_m,
+              "Farthest depth searched (m); inf searches to the vanishing point")
+      .number("min_parallax_deg", "min-parallax", &d->min_parallax_deg,
+              "Least parallax of a reference frame at the mid-range depth (deg)")
+      .number("max_optical_axis_angle_deg", "max-axis-angle", &d->max_optical_axis_angle_deg,
+              "Largest angle between the optical axes of keyframe and reference (deg)")
+      .number("max_gradient_epipolar_angle_deg", "max-gradient-epipolar-angle",
+              &d->max_gradient_epipolar_angle_deg,
+              "Largest angle between a pixel's gradient and its epipolar line (deg)")
+      .number("patch_half_size_1d", "patch-1d", &d->patch_half_size_1d,
+              "Half size of the 1D patch along the epipolar line (samples)")
+      .number("patch_half_size_2d", "patch-2d", &d->patch_half_size_2d,
+              "Half size of the square 2D check patch (px)")
+      .number("max_candidates", "max-candidates", &d->max_candidates,
+              "Best 1D minima kept for the 2D check")
+      .boolean("subtract_patch_mean", "subtract-patch-mean", &d->subtract_patch_mean,
+               "Compare patches after subtracting their means")
+      .number("max_patch_rms_grey", "max-patch-rms", &d->max_patch_rms_grey,
+              "Largest RMS patch difference of a match (grey levels)")
+      .number("max_ambiguity_ratio", "max-ambiguity-ratio", &d->max_ambiguity_ratio,
+              "Best 2D cost at most this fraction of the next best")
+      .number("image_noise_sigma_grey", "image-noise", &d->image_noise_sigma_grey,
+              "Image noise std dev (grey levels)")
+      .number("epipolar_sigma_px", "epipolar-sigma", &d->epipolar_sigma_px,
+              "Std dev of the epipolar line position from pose error (px)")
+      .number("max_relative_inverse_depth_sigma", "max-relative-sigma",
+              &d->max_relative_inverse_depth_sigma,
+              "Largest inverse-depth std dev as a fraction of the inverse depth")
+      .number("pixel_step", "pixel-step", &d->pixel_step, "Search every k-th chain pixel (px)")
+      .number("smoothing_half_window", "smoothing-half-window", &d->smoothing_half_window,
+              "Half window of the robust average along a chain (pixels); 0 turns it off")
+      .number("min_window_support", "min-window-support", &d->min_window_support,
+              "Least consistent depths in a pixel's window")
+      .number("outlier_sigmas", "outlier-sigmas", &d->outlier_sigmas,
+              "Outlier distance from the window median (std devs)");
+}
+
+void addCurveStages(OptionsTable* table, PipelineOptions* o, const std::string& path) {
+  CurveInitialiserOptions* i = &o->initialiser;
+  const OptionPlace p = stage(path, "initialiser", "init-", "Curve initialisation");
+  table->group(i, "CurveInitialiserOptions", p.path, p.prefix, p.heading)
+      .number("pixels_per_segment", "pixels-per-segment", &i->pixels_per_segment,
+              "Target lifted pixels per Bezier segment")
+      .number("min_segments", "min-segments", &i->min_segments,
+              "Curves with fewer segments are dropped")
+      .number("max_gap_px", "max-gap", &i->max_gap_px,
+              "Longest bridged run of pixels without depth (chain pixels)")
+      .number("max_relative_depth_jump", "max-depth-jump", &i->max_relative_depth_jump,
+              "A run ends at a relative depth jump above this")
+      .number("max_rms_residual_rel_chord", "max-rms-residual", &i->max_rms_residual_rel_chord,
+              "Reject a segment whose RMS fit residual exceeds this fraction of its chord")
+      .number("min_chord_m", "min-chord", &i->min_chord_m,
+              "Reject segments with a shorter chord (m)")
+      .number("max_arm_to_chord", "max-arm-to-chord", &i->max_arm_to_chord,
+              "Reject a segment whose arm exceeds this multiple of its chord");
+  CurveExtensionOptions* x = &o->extension;
+  const OptionPlace e = stage(path, "extension", "extend-", "Curve extension");
+  table->group(x, "CurveExtensionOptions", e.path, e.prefix, e.heading)
+      .boolean("enabled", "curves", &x->enabled,
+               "Append a new curve that continues an existing curve's end to that curve")
+      .number("max_gap_px", "max-gap", &x->max_gap_px,
+              "Largest gap between the projected end points (px)")
+      .number("max_lateral_px", "max-lateral", &x->max_lateral_px,
+              "Largest offset across the existing end's image tangent, and overlap behind it (px)")
+      .number("max_angle_deg", "max-angle", &x->max_angle_deg,
+              "Largest angle between the two curves' image directions at the join (deg)")
+      .number("max_relative_depth_gap", "max-depth-gap", &x->max_relative_depth_gap,
+              "Largest 3D gap between the end points, as a fraction of the existing end's depth");
+  CorrespondenceOptions* c = &o->correspondence;
+  const OptionPlace m = stage(path, "correspondence", "match-", "Correspondence checks");
+  table->group(c, "CorrespondenceOptions", m.path, m.prefix, m.heading)
+      .number("samples_per_segment", "samples-per-segment", &c->samples_per_segment,
+              "Samples per segment of the checks")
+      .number("min_depth_m", "min-depth", &c->min_depth_m,
+              "Least depth of every sample in the new camera (m)")
+      .number("max_mean_edge_distance_px", "max-edge-distance", &c->max_mean_edge_distance_px,
+              "Largest mean distance to the nearest edge (px)")
+      .number("appearance_half_width_px", "appearance-half-width", &c->appearance_half_width_px,
+              "Half width of the appearance band (px)")
+      .number("hue_weight", "hue-weight", &c->hue_weight,
+              "Weight lambda of the hue term of the appearance error")
+      .number("max_appearance_error", "max-appearance-error", &c->max_appearance_error,
+              "Largest HSV appearance error")
+      .number("max_viewing_angle_deg", "max-viewing-angle", &c->max_viewing_angle_deg,
+              "Largest angle to the mean earlier viewing direction (deg)");
+  CurveMapOptions* map = &o->map;
+  const OptionPlace k = stage(path, "map", "map-", "Maps and keyframes");
+  table->group(map, "CurveMapOptions", k.path, k.prefix, k.heading)
+      .number("promotion_observations", "promotion-observations", &map->promotion_observations,
+              "Keyframes that move a temporary curve to the global map")
+      .number("disable_window_keyframes", "disable-window", &map->disable_window_keyframes,
+              "Recent keyframes over which a curve must stay visible")
+      .number("disable_unseen_fraction", "disable-unseen-fraction", &map->disable_unseen_fraction,
+              "Disable a curve when more of its segments than this went unseen in the window")
+      .number("min_keyframe_translation", "keyframe-translation", &map->min_keyframe_translation,
+              "New keyframe when the initial camera centre moved more than this (pose units)")
+      .number("min_keyframe_rotation_deg", "keyframe-rotation", &map->min_keyframe_rotation_deg,
+              "... or turned more than this (deg)");
+}
+
+}  // namespace
+
+OptionPlace OptionPlace::child(const std::string& field) const {
+  return {path + "/" + field, prefix, heading, what};
+}
+
+std::string OptionPlace::describe(const std::string& text) const {
+  if (!what.empty()) return what + ": " + text;
+  std::string sentence = text;
+  if (!sentence.empty()) sentence[0] = static_cast<char>(std::toupper(sentence[0]));
+  return sentence;
+}
+
+void addOptimizerOptions(OptionsTable* table, OptimizerOptions* o, const OptionPlace& place) {
+  table->group(o, "OptimizerOptions", place.path, place.prefix, place.heading)
+      .enumeration("linear_solver", "linear-solver", &o->linear_solver,
+                   place.describe("linear solver of each step"))
+      .enumeration("trust_region", "trust-region", &o->trust_region,
+                   place.describe("trust-region strategy"))
+      .number("max_iterations", "max-iterations", &o->max_iterations,
+              place.describe("most solver iterations per solve"))
+      .threads("num_threads", "threads", &o->num_threads, place.describe("solver threads"))
+      .number("function_tolerance", "function-tolerance", &o->function_tolerance,
+              place.describe("stop when the relative cost change falls below this"))
+      .number("gradient_tolerance", "gradient-tolerance", &o->gradient_tolerance,
+              place.describe("stop when the max gradient falls below this"))
+      .number("parameter_tolerance", "parameter-tolerance", &o->parameter_tolerance,
+              place.describe("stop when the relative step falls below this"))
+      .boolean("structure_first_ordering", "structure-first", &o->structure_first_ordering,
+               place.describe("Schur order structure first (false: Ceres chooses)"))
+      .boolean("use_inner_iterations", "inner-iterations", &o->use_inner_iterations,
+               place.describe("Ceres inner iterations"))
+      .boolean("verbose", "verbose", &o->verbose, place.describe("print Ceres' iteration log"));
+}
+
+void addSchedulerOptions(OptionsTable* table, SchedulerOptions* s, const OptionPlace& place,
+                         const bool* fix_first_pose) {
+  table->group(s, "SchedulerOptions", place.path, place.prefix, place.heading)
+      .enumeration("strategy", "strategy", &s->strategy,
+                   place.describe("how the free variables are split into solves"))
+      .enumeration("scope", "scope", &s->scope,
+                   place.describe("free variables: all (global) or the last keyframes' (local)"))
+      .number("local_window", "local-window", &s->local_window,
+              place.describe("free keyframes in local scope"))
+      .number("max_rounds", "max-rounds", &s->max_rounds,
+              place.describe("alternating: most rounds"))
+      .number("round_tolerance", "round-tolerance", &s->round_tolerance,
+              place.describe("alternating: stop when a round gains less than this fraction"))
+      .derived(
+          "fix_first_pose", [fix_first_pose] { return nlohmann::json(*fix_first_pose); },
+          "the gauge switch of the bundle adjustment options (fix-first-pose)")
+      .nested("optimizer");
+  addOptimizerOptions(table, &s->optimizer, place.child("optimizer"));
+}
+
+void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentOptions* b,
+                                     const OptionPlace& place) {
+  table->group(b, "CurveBundleAdjustmentOptions", place.path, place.prefix, place.heading)
+      .number("samples_per_segment", "samples-per-segment", &b->samples_per_segment,
+              "s: residuals per (segment, keyframe) pair are s + 1")
+      .boolean("use_subpixel_edges", "subpixel-edges", &b->use_subpixel_edges,
+               "Measure against the sub-pixel edge position (false: the edge pixel centre)")
+      .number("max_normal_angle_deg", "max-normal-angle", &b->max_normal_angle_deg,
+              "Match only edges whose normal is within this angle of the curve's (deg); 90 "
+              "accepts every match")
+      .number("pixel_sigma", "pixel-sigma", &b->pixel_sigma, "Std dev of an edge residual (px)")
+      .enumeration("kernel", "kernel", &b->kernel, "Robust kernel on edge residuals")
+      .number("kernel_width", "kernel-width", &b->kernel_width, "Kernel width (sigmas)")
+      .number("lambda1", "lambda1", &b->lambda1,
+              "Weight of the segment-length term (px^2/m^2); 0 drops it")
+      .number("lambda2", "lambda2", &b->lambda2,
+              "Weight of the tangent term (px^2/rad^2); 0 drops it")
+      .boolean("fix_first_pose", "fix-first-pose", &b->fix_first_pose,
+               "Hold keyframe 0 constant (rotation and translation gauge)")
+      .boolean("fix_scale", "fix-scale", &b->fix_scale,
+               "Hold the distance between keyframes 0 and 1 (scale gauge)")
+      .number("scale_sigma", "scale-sigma", &b->scale_sigma,
+              "Std dev of that distance constraint (pose units)")
+      .boolean("motion_prior", "motion-prior", &b->motion_prior,
+               "Tie the motion between consecutive keyframes to the initial poses'")
+      .number("motion_prior_rotation_sigma_deg", "motion-prior-rotation",
+              &b->motion_prior_rotation_sigma_deg,
+              "Std dev per axis of that motion's rotation (deg)")
+      .number("motion_prior_translation_sigma_rel", "motion-prior-translation",
+              &b->motion_prior_translation_sigma_rel,
+              "Std dev per axis of that motion's translation, as a fraction of the mean distance "
+              "between consecutive keyframes");
+}
+
+void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentOptions* b,
+                                     const OptionPlace& place) {
+  table->group(b, "PointBundleAdjustmentOptions", place.path, place.prefix, place.heading)
+      .number("pixel_sigma", "pixel-sigma", &b->pixel_sigma, "Std dev of an image residual (px)")
+      .enumeration("kernel", "kernel", &b->kernel, "Robust kernel on image residuals")
+      .number("kernel_width", "kernel-width", &b->kernel_width, "Kernel width (sigmas)")
+      .boolean("fix_first_pose", "fix-first-pose", &b->fix_first_pose,
+               "Hold the first camera constant (rotation and translation gauge)")
+      .boolean("fix_scale", "fix-scale", &b->fix_scale,
+               "Hold the distance between the first two cameras (scale gauge)")
+      .number("scale_sigma", "scale-sigma", &b->scale_sigma,
+              "Std dev of that distance constraint (scene units)");
+}
+
+void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::string& path) {
+  table->group(o, "PipelineOptions", path, "", "Pipeline")
+      .nested("undistort")
+      .nested("edges")
+      .nested("chains")
+      .nested("field")
+      .nested("depth")
+      .nested("initialiser")
+      .nested("extension")
+      .nested("correspondence")
+      .nested("map")
+      .nested("ba")
+      .nested("local_ba")
+      .boolean("local_ba_refines_poses", "local-ba-refine-poses", &o->local_ba_refines_poses,
+               "local BA: move the window's poses too (else curves alone)")
+      .nested("global_ba")
+      .boolean("run_global_ba", "run-global-ba", &o->run_global_ba,
+               "Run global BA after the last frame")
+      .number("reassociation_rounds", "reassociation-rounds", &o->reassociation_rounds,
+              "After global BA: rounds of re-registering every curve in every keyframe, each "
+              "followed by global BA (0: none)")
+      .number("depth_reference_candidates", "depth-reference-candidates",
+              &o->depth_reference_candidates, "Recent keyframes considered as depth references")
+      .boolean("track_keyframe_pose", "track-keyframe-pose", &o->track_keyframe_pose,
+               "Refine a new keyframe's starting pose against the map before registration")
+      .nested("tracking")
+      .number("explained_radius_px", "explained-radius", &o->explained_radius_px,
+              "Chain pixels this close to a registered segment seed no new curve (px)");
+  addImageStages(table, o, path);
+  addDepth(table, &o->depth, path);
+  addCurveStages(table, o, path);
+  addCurveBundleAdjustmentOptions(table, &o->ba, stage(path, "ba", "ba-", "BA objective"));
+  addSchedulerOptions(table, &o->local_ba,
+                      {path + "/local_ba", "local-ba-", "Local BA", "local BA"},
+                      &o->ba.fix_first_pose);
+  addSchedulerOptions(table, &o->global_ba,
+                      {path + "/global_ba", "global-ba-", "Global BA", "global BA"},
+                      &o->ba.fix_first_pose);
+  addOptimizerOptions(table, &o->tracking,
+                      {path + "/tracking", "track-", "Pose tracking", "pose tracking"});
+}
+
+void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* o, const OptionPlace& place) {
+  table->group(o, "CurveOverlayOptions", place.path, place.prefix, place.heading)
+      .number("samples_per_segment", "samples", &o->samples_per_segment,
+              "Samples per segment of the drawn curves")
+      .text(
+          "colour", "colour", "B,G,R",
+          [o] {
+            return formatOptionValue(o->colour[0]) + "," + formatOptionValue(o->colour[1]) + "," +
+                   formatOptionValue(o->colour[2]);
+          },
+          [o](const std::string& text) {
+            const Eigen::Vector3d bgr = parseVector3(text, "CurveOverlayOptions", "colour");
+            o->colour = cv::Scalar(bgr.x(), bgr.y(), bgr.z());
+          },
+          "Colour of the drawn curves, blue, green, red in [0, 255]")
+      .number("thickness_px", "thickness", &o->thickness_px, "Line thickness (px)")
+      .number("point_radius_px", "point-radius", &o->point_radius_px,
+              "Radius of the dots at segment ends (px); 0 draws none");
+}
+
+void addCameraIntrinsics(OptionsTable* table, CameraIntrinsics* k, const OptionPlace& place) {
+  table->group(k, "CameraIntrinsics", place.path, place.prefix, place.heading)
+      .number("fx", "fx", &k->fx, "Focal length along x (px)")
+      .number("fy", "fy", &k->fy, "Focal length along y (px)")
+      .number("cx", "cx", &k->cx, "Principal point x (px)")
+      .number("cy", "cy", &k->cy, "Principal point y (px)")
+      .number("k1", "k1", &k->k1, "Radial distortion k1")
+      .number("k2", "k2", &k->k2, "Radial distortion k2")
+      .number("p1", "p1", &k->p1, "Tangential distortion p1")
+      .number("p2", "p2", &k->p2, "Tangential distortion p2")
+      .number("k3", "k3", &k->k3, "Radial distortion k3")
+      .number("width", "width", &k->width, "Image width (px)")
+      .number("height", "height", &k->height, "Image height (px)");
+}
+
+void addCurveSceneOptions(OptionsTable* table, CurveSceneOptions* o, const OptionPlace& place) {
+  table->group(o, "CurveSceneOptions", place.path, place.prefix, place.heading)
+      .number("num_keyframes", "keyframes", &o->num_keyframes, "Keyframes (rendered images)")
+      .enumeration("camera_path", "camera-path", &o->camera_path, "Where the keyframes are")
+      .number("camera_distance", "camera-distance", &o->camera_distance,
+              "Distance of the cameras from the room centre (m)")
+      .number("arc_degrees", "arc", &o->arc_degrees, "orbit: angle spanned by the keyframes (deg)")
+      .number("walk_length", "walk-length", &o->walk_length,
+              "forward_walk: distance from the first to the last keyframe (m)")
+      .nested("intrinsics")
+      .number("num_curves", "curves", &o->num_curves, "3D curves in the room")
+      .enumeration("curve_kind", "curve-kind", &o->curve_kind, "Shape of the curves")
+      .number("segments_per_curve", "segments-per-curve", &o->segments_per_curve,
+              "Cubic segments per curve")
+      .number("min_curve_length", "min-curve-length", &o->min_curve_length, "Shortest curve (m)")
+      .number("max_curve_length", "max-curve-length", &o->max_curve_length, "Longest curve (m)")
+      .text(
+          "volume_half_extents", "volume-half-extents", "X,Y,Z",
+          [o] { return printVector3(o->volume_half_extents); },
+          [o](const std::string& text) {
+            o->volume_half_extents = parseVector3(text, "CurveSceneOptions", "volume_half_extents");
+          },
+          "Half extents of the box around the room centre that holds the curves (m)")
+      .number("min_camera_distance", "min-camera-distance", &o->min_camera_distance,
+              "Least distance of a curve point from every camera centre (m)")
+      .number("edge_blur_sigma_px", "edge-blur-sigma", &o->edge_blur_sigma_px,
+              "Blur of the rendered step edges (px)")
+      .number("step_contrast", "step-contrast", &o->step_contrast,
+              "Intensity step across a rendered edge (8-bit units)")
+      .number("pixel_noise", "image-noise", &o->pixel_noise,
+              "Std dev of the image intensity noise (8-bit units)")
+      .number("canny_low_threshold", "canny-low", &o->canny_low_threshold,
+              "Canny low threshold of the scene's edge images")
+      .number("canny_high_threshold", "canny-high", &o->canny_high_threshold,
+              "Canny high threshold of the scene's edge images")
+      .number("num_clutter_edges", "clutter", &o->num_clutter_edges,
+              "Edges per image that belong to no 3D curve")
+      .number("occlusion_fraction", "occlusion", &o->occlusion_fraction,
+              "Probability that 30-50% of a curve is hidden in a keyframe")
+      .number("min_visible_fraction", "min-visible-fraction", &o->min_visible_fraction,
+              "A segment is observed in a keyframe when this fraction of it is in the image")
+      .number("visibility_margin_px", "visibility-margin", &o->visibility_margin_px,
+              "Margin inside the image border of a visible sample (px)")
+      .number("min_projected_length_px", "min-projected-length", &o->min_projected_length_px,
+              "Shortest projected segment that counts as observed (px)")
+      .number("pose_noise_translation", "pose-noise-trans", &o->pose_noise_translation,
+              "Start-guess camera centre noise (m)")
+      .number("pose_noise_rotation_deg", "pose-noise-rot", &o->pose_noise_rotation_deg,
+              "Start-guess rotation noise (deg)")
+      .number("curve_point_noise", "curve-point-noise", &o->curve_point_noise,
+              "Start-guess noise of the curve points Q (m)")
+      .number("curve_tangent_noise_deg", "curve-tangent-noise", &o->curve_tangent_noise_deg,
+              "Start-guess noise of the tangents v per component (deg)")
+      .number("curve_length_noise", "curve-length-noise", &o->curve_length_noise,
+              "Start-guess relative noise of the tangent lengths d1, d2")
+      .number("seed", "seed", &o->seed, "Random seed");
+  addCameraIntrinsics(table, &o->intrinsics,
+                      {place.path + "/intrinsics", place.prefix + "camera-", place.heading, ""});
+}
+
+void addPointSceneOptions(OptionsTable* table, PointSceneOptions* o, const OptionPlace& place) {
+  table->group(o, "PointSceneOptions", place.path, place.prefix, place.heading)
+      .number("num_cameras", "cameras", &o->num_cameras, "Cameras on the arc")
+      .number("num_points", "points", &o->num_points, "Points in the cube")
+      .number("track_length", "track-length", &o->track_length,
+              "Consecutive cameras seeing each point")
+      .number("orbit_radius", "orbit-radius", &o->orbit_radius,
+              "Distance of the cameras from the cube centre (m)")
+      .number("arc_degrees", "arc", &o->arc_degrees, "Angle spanned by the camera arc (deg)")
+      .number("cube_half_size", "cube-half-size", &o->cube_half_size,
+              "Half edge of the point cube (m)")
+      .number("pixel_noise", "pixel-noise", &o->pixel_noise, "Pixel noise std dev (px)")
+      .number("pose_noise_translation", "pose-noise-trans", &o->pose_noise_translation,
+              "Start-guess camera centre noise (m)")
+      .number("pose_noise_rotation_deg", "pose-noise-rot", &o->pose_noise_rotation_deg,
+              "Start-guess rotation noise (deg)")
+      .number("point_noise", "point-noise", &o->point_noise, "Start-guess point noise (m)")
+      .number("seed", "seed", &o->seed, "Random seed")
+      .nested("intrinsics");
+  addCameraIntrinsics(table, &o->intrinsics,
+                      {place.path + "/intrinsics", place.prefix + "camera-", place.heading, ""});
+}
+
+void addPlanarSceneOptions(OptionsTable* table, PlanarSceneOptions* o, const OptionPlace& place) {
+  table->group(o, "PlanarSceneOptions", place.path, place.prefix, place.heading)
+      .number("num_frames", "frames", &o->num_frames, "Views along the orbit arc")
+      .number("intensity_noise", "noise", &o->intensity_noise,
+              "P: std dev of the per-pixel, per-channel intensity noise as a fraction of 255 "
+              "(0.05 = 5%)")
+      .number("seed", "seed", &o->seed, "Random seed of the noise and the initial poses")
+      .enumeration("init_noise_model", "init-noise-model", &o->init_noise_model,
+                   "Initial poses: every pose perturbed on its own (independent) or every motion "
+                   "between consecutive frames, errors accumulating as in visual odometry (drift)")
+      .number("init_noise_translation", "init-noise-trans", &o->init_noise_translation,
+              "Initial poses: std dev per axis of the camera-centre error (m), per pose or, "
+              "with drift, per step")
+      .number("init_noise_rotation_deg", "init-noise-rot", &o->init_noise_rotation_deg,
+              "Initial poses: std dev per axis of the rotation error (deg), per pose or, with "
+              "drift, per step")
+      .number("width", "width", &o->width, "Image width (px); the principal point is centred")
+      .number("height", "height", &o->height, "Image height (px)")
+      .number("fx", "fx", &o->fx, "Focal length along x (px)")
+      .number("fy", "fy", &o->fy, "Focal length along y (px)")
+      .derived(
+          "cx", [o] { return nlohmann::json(0.5 * (o->width - 1)); }, "centred: (width - 1) / 2")
+      .derived(
+          "cy", [o] { return nlohmann::json(0.5 * (o->height - 1)); }, "centred: (height - 1) / 2")
+      .number("plane_width", "plane-width", &o->plane_width,
+              "Extent of the photo's longer side on the plane (m)")
+      .number("orbit_radius", "orbit-radius", &o->orbit_radius,
+              "Horizontal distance of the cameras from the plane centre (m)")
+      .number("camera_height", "camera-height", &o->camera_height, "Height of the orbit (m)")
+      .number("arc_degrees", "arc", &o->arc_degrees, "Orbit arc spanned by the views (deg)");
+}
+
+void addTrajectoryEvaluationOptions(OptionsTable* table, TrajectoryEvaluationOptions* o,
+                                    const OptionPlace& place) {
+  table->group(o, "TrajectoryEvaluationOptions", place.path, place.prefix, place.heading)
+      .enumeration("alignment", "align", &o->alignment,
+                   "Alignment of the estimate onto the ground truth (sim3 for monocular)")
+      .number("max_dt", "max-dt", &o->max_dt, "Largest time difference of a matched pose pair (s)")
+      .number("rpe_delta", "rpe-delta", &o->rpe_delta, "RPE over this many matched poses (frames)");
+}
+
+}  // namespace curvesfm

@@ -1,0 +1,63 @@
+#pragma once
+
+#include <string>
+
+#include "apps/cli/options_table.h"
+#include "core/camera.h"
+#include "core/trajectory_evaluation.h"
+#include "factors/curve_bundle_adjustment.h"
+#include "factors/point_bundle_adjustment.h"
+#include "frontend/image/curve_overlay.h"
+#include "frontend/mapping/pipeline.h"
+#include "graph/optimizer.h"
+#include "graph/scheduler.h"
+#include "sim/curve_scene.h"
+#include "sim/planar_scene.h"
+#include "sim/point_scene.h"
+
+namespace curvesfm {
+
+// The table of every options struct: one function per struct adds a row per field (see
+// options_table.h). Flags keep the names users know; a struct that appears twice in a command
+// (the optimizer of local BA, global BA and tracking) takes a prefix per place.
+
+/// Where a struct's rows go.
+struct OptionPlace {
+  std::string path;     ///< JSON pointer below report.json's "options", e.g. "/pipeline/local_ba".
+  std::string prefix;   ///< Prepended to every flag, e.g. "local-ba-".
+  std::string heading;  ///< --help heading, e.g. "Local BA".
+  std::string what;     ///< Names the solve in descriptions, e.g. "local BA"; may be empty.
+
+  /// The place of nested struct `field`: its path below this one, the same prefix and heading.
+  OptionPlace child(const std::string& field) const;
+  /// `text` led by `what` when there is one: "local BA: most rounds".
+  std::string describe(const std::string& text) const;
+};
+
+void addOptimizerOptions(OptionsTable* table, OptimizerOptions* options, const OptionPlace& place);
+/// fix_first_pose is not a flag: the command holds one gauge switch, `*fix_first_pose`, for the
+/// graph builder and the scheduler.
+void addSchedulerOptions(OptionsTable* table, SchedulerOptions* options, const OptionPlace& place,
+                         const bool* fix_first_pose);
+void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentOptions* options,
+                                     const OptionPlace& place);
+void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentOptions* options,
+                                     const OptionPlace& place);
+/// Every stage of the pipeline under `path`, flags named by stage (`--edges-*`, `--depth-*`,
+/// `--local-ba-*`, ...).
+void addPipelineOptions(OptionsTable* table, PipelineOptions* options, const std::string& path);
+void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* options,
+                            const OptionPlace& place);
+void addCameraIntrinsics(OptionsTable* table, CameraIntrinsics* intrinsics,
+                         const OptionPlace& place);
+void addCurveSceneOptions(OptionsTable* table, CurveSceneOptions* options,
+                          const OptionPlace& place);
+void addPointSceneOptions(OptionsTable* table, PointSceneOptions* options,
+                          const OptionPlace& place);
+/// cx and cy are not flags: `curvesfm synth planar` centres the principal point.
+void addPlanarSceneOptions(OptionsTable* table, PlanarSceneOptions* options,
+                           const OptionPlace& place);
+void addTrajectoryEvaluationOptions(OptionsTable* table, TrajectoryEvaluationOptions* options,
+                                    const OptionPlace& place);
+
+}  // namespace curvesfm

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
     curvesfm::parseCommandLine(&app, std::vector<std::string>(argv + 1, argv + argc));
     // Options out of range are usage errors too; validating here keeps them apart from a run
     // that fails.
+    if (point_ba.selected()) point_ba.validate();
     if (curve_ba.selected()) curve_ba.validate();
     if (eval.selected()) eval.validate();
     if (synth.selected()) synth.validate();

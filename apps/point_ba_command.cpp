@@ -57,10 +57,14 @@ PointBaCommand::PointBaCommand(CLI::App* app) {
   c->add_option("--report", report_path_, "Write a JSON report (configuration, errors, solver)");
 }
 
-int PointBaCommand::run() const {
+void PointBaCommand::validate() const {
   scene_.validate();
   ba_.validate();
   optimizer_.validate();
+}
+
+int PointBaCommand::run() const {
+  validate();
 
   const PointScene scene = makePointScene(scene_);
   std::printf("scene: %zu cameras, %zu points, %zu observations (seed %u)\n",

@@ -15,6 +15,8 @@ class PointBaCommand {
  public:
   explicit PointBaCommand(CLI::App* app);
   bool selected() const { return command_->parsed(); }
+  /// Throws InvalidOptions for an option out of range (main reports it as a usage error).
+  void validate() const;
   /// Runs the command; returns the process exit code.
   int run() const;
 

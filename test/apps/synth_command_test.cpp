@@ -102,6 +102,9 @@ TEST_F(SynthCommandTest, BadValuesAreUsageErrorsNamingTheOption) {
   result = runCurvesfm(flags + " --frames 1");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("PlanarSceneOptions.num_frames = 1"));
+  result = runCurvesfm(flags + " --frames 100000");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("PlanarSceneOptions.num_frames = 100000: must be <= 4660"));
   result = runCurvesfm(flags + " --init-noise-model gaussian");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("expected one of independent, drift"));

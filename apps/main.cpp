@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "apps/cli/cli_options.h"
+#include "apps/cli/report_json.h"
 #include "apps/curve_ba_command.h"
 #include "apps/eval_command.h"
 #include "apps/point_ba_command.h"
@@ -18,6 +19,10 @@ int main(int argc, char** argv) {
       "curvesfm: curve-based structure from motion (poly-Bezier curves + bundle adjustment)"};
   app.name("curvesfm");  // for the usage line; parsing a vector does not read argv[0]
   app.require_subcommand(1);
+  // `curvesfm --version` prints "curvesfm <version> (<git commit>)" and exits 0.
+  const nlohmann::json version = curvesfm::versionJson();
+  app.set_version_flag("--version", "curvesfm " + version["version"].get<std::string>() + " (" +
+                                        version["commit"].get<std::string>() + ")");
   // A flag given in the config file and again on the command line: the last one wins.
   app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   curvesfm::PointBaCommand point_ba(&app);
@@ -31,6 +36,7 @@ int main(int argc, char** argv) {
     curvesfm::parseCommandLine(&app, std::vector<std::string>(argv + 1, argv + argc));
     // Options out of range are usage errors too; validating here keeps them apart from a run
     // that fails.
+    if (point_ba.selected()) point_ba.validate();
     if (curve_ba.selected()) curve_ba.validate();
     if (eval.selected()) eval.validate();
     if (synth.selected()) synth.validate();

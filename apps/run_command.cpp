@@ -349,6 +349,7 @@ int RunCommand::run() const {
   const CurveGrowth growth = curveGrowth(result.frames);
   writeJsonFile(joinPath(out_dir_, "report.json"),
                 {{"command", "run"},
+                 {"curvesfm", versionJson()},
                  {"config", optionsToJson(*command_)},
                  {"options", runOptionsJson()},
                  {"dataset",

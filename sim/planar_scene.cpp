@@ -133,6 +133,12 @@ CameraIntrinsics PlanarSceneOptions::intrinsics() const {
   return intrinsics;
 }
 
+int maxPlanarFrames(int width, int height) {
+  const std::int64_t frame_bytes = std::int64_t{width} * height * 3;
+  return static_cast<int>(std::min<std::int64_t>(
+      kMaxPlanarFrames, kMaxPlanarSceneBytes / std::max<std::int64_t>(frame_bytes, 1)));
+}
+
 void PlanarSceneOptions::validate() const {
   const OptionCheck require("PlanarSceneOptions");
   require(num_frames >= 2, "num_frames", num_frames, "must be >= 2");
@@ -144,6 +150,11 @@ void PlanarSceneOptions::validate() const {
           "init_noise_rotation_deg", init_noise_rotation_deg, "must be finite and >= 0");
   require(width >= 1 && width <= kMaxImageSide, "width", width, "must be in [1, 16384]");
   require(height >= 1 && height <= kMaxImageSide, "height", height, "must be in [1, 16384]");
+  const int max_frames = maxPlanarFrames(width, height);
+  require(num_frames <= max_frames, "num_frames", num_frames,
+          "must be <= " + std::to_string(max_frames) + " for " + std::to_string(width) + "x" +
+              std::to_string(height) + " views (at most " + std::to_string(kMaxPlanarFrames) +
+              ", and the views held in memory, frames x width x height x 3 bytes, within 4 GiB)");
   require(std::isfinite(fx) && fx > 0.0, "fx", fx, "must be finite and > 0");
   require(std::isfinite(fy) && fy > 0.0, "fy", fy, "must be finite and > 0");
   require(std::isfinite(cx), "cx", cx, "must be finite");

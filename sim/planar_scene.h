@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
@@ -28,6 +29,22 @@ inline constexpr int kPlanarBackground = 0;
 /// Frame period of the rendered sequence: timestamps are i / 30 s, a TUM RGB-D camera's rate.
 inline constexpr double kPlanarFramePeriod = 1.0 / 30.0;
 
+/// The most views a planar scene may have, whatever their size: 10000 views are 5.6 minutes at
+/// 30 Hz, twice the longest TUM RGB-D sequences (about 3000 frames), and as many PNG files.
+inline constexpr int kMaxPlanarFrames = 10000;
+
+/// The most bytes of rendered views a planar scene holds in memory (4 GiB). makePlanarScene()
+/// keeps every view (width x height x 3 bytes for a colour photo) until the dataset is written,
+/// and writePlanarDataset() writes each as a PNG of about that size (the added noise leaves
+/// little to compress); 4 GiB leaves most of a 16 GB machine to the rest of the process and to
+/// whatever else runs on it.
+inline constexpr std::int64_t kMaxPlanarSceneBytes = std::int64_t{4} << 30;
+
+/// The most views a scene of width x height (>= 1 px) colour views may have: the smaller of
+/// kMaxPlanarFrames and kMaxPlanarSceneBytes / (width x height x 3), e.g. 4660 at 640x480
+/// (4,294,967,296 / 921,600 B), 1165 at 1280x960, 5 at the largest 16384x16384 (805 MB each).
+int maxPlanarFrames(int width, int height);
+
 /// How the starting guess departs from the true trajectory.
 enum class InitNoiseModel {
   /// Every pose perturbed on its own: errors of neighbouring frames are unrelated.
@@ -53,7 +70,9 @@ struct EnumNames<InitNoiseModel> {
 /// apart and see the plane's centre from directions 32 deg apart, enough to triangulate well
 /// without a strong perspective change between neighbours.
 struct PlanarSceneOptions {
-  int num_frames = 30;  ///< Views along the orbit; >= 2.
+  /// Views along the orbit; in [2, maxPlanarFrames(width, height)] (4660 at the default
+  /// 640x480): every view is held in memory until written.
+  int num_frames = 30;
   /// P: std dev of the Gaussian noise added to every pixel and channel, as a fraction of 255
   /// (0.05 gives a std dev of 12.75 levels), before rounding and clipping to [0, 255]; [0, 1].
   double intensity_noise = 0.0;

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <fstream>
+#include <map>
 
 #include "core/errors.h"
 
@@ -18,27 +19,29 @@ std::string commandPath(const CLI::App& command) {
   return commandPath(*parent) + " " + command.get_name();
 }
 
+// What a YAML node is, for the "found" part of a message.
+std::string nodeKind(const YAML::Node& node) {
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a nested mapping";
+  return "'" + node.as<std::string>("") + "'";
+}
+
 void appendOption(const std::string& path, const std::string& name, const YAML::Node& value,
                   const CLI::Option& option, std::vector<std::string>* args) {
   const int line = value.Mark().line + 1;
-  if (value.IsMap()) {
-    throw ParseError(path, line, "a value for flag '" + name + "'", "a nested mapping");
+  if (value.IsMap() || value.IsSequence()) {
+    throw ParseError(path, line, "a single value for flag '" + name + "'", nodeKind(value));
   }
   if (isFlag(option)) {
     bool on = false;
     if (!YAML::convert<bool>::decode(value, on)) {
-      throw ParseError(path, line, "true or false for flag '" + name + "'",
-                       "'" + value.as<std::string>("") + "'");
+      throw ParseError(path, line, "true or false for flag '" + name + "'", nodeKind(value));
     }
     if (on) args->push_back("--" + name);
     return;
   }
   args->push_back("--" + name);
-  if (value.IsSequence()) {
-    for (const auto& element : value) args->push_back(element.as<std::string>());
-  } else {
-    args->push_back(value.as<std::string>(""));
-  }
+  args->push_back(value.as<std::string>(""));
 }
 
 }  // namespace
@@ -55,13 +58,25 @@ std::vector<std::string> configFileArguments(const std::string& path, const CLI:
   std::vector<std::string> args;
   if (root.IsNull()) return args;
   if (!root.IsMap()) throw ParseError(path, 1, "a mapping of flag names to values", "no mapping");
+  // yaml-cpp keeps every entry of a key given twice (a lookup finds the first, the command line
+  // would take the last), so repeated keys are caught here, with the line of each.
+  std::map<std::string, int> key_lines;
   for (const auto& entry : root) {
+    const int line = entry.first.Mark().line + 1;
+    if (!entry.first.IsScalar()) {
+      throw ParseError(path, line, "a flag name as key", nodeKind(entry.first));
+    }
     const std::string name = entry.first.as<std::string>();
     const CLI::Option* option = command.get_option_no_throw("--" + name);
     if (!option || name == "config" || name == "help") {
-      throw ParseError(path, entry.first.Mark().line + 1,
-                       "a flag of 'curvesfm " + commandPath(command) + "' (see --help)",
+      throw ParseError(path, line, "a flag of 'curvesfm " + commandPath(command) + "' (see --help)",
                        "'" + name + "'");
+    }
+    const auto [first, inserted] = key_lines.emplace(name, line);
+    if (!inserted) {
+      throw ParseError(
+          path, line, "each flag once",
+          "'" + name + "' again (first on line " + std::to_string(first->second) + ")");
     }
     appendOption(path, name, entry.second, *option, &args);
   }

@@ -2,9 +2,14 @@
 
 #include <fstream>
 
+#include "apps/cli/version_info.h"  // generated under the build tree (apps/cli/CMakeLists.txt)
 #include "core/errors.h"
 
 namespace curvesfm {
+
+nlohmann::json versionJson() {
+  return {{"version", CURVESFM_VERSION}, {"commit", CURVESFM_GIT_COMMIT}};
+}
 
 nlohmann::json costsToJson(const std::map<std::string, FactorTypeCost>& costs) {
   nlohmann::json json = nlohmann::json::object();

@@ -13,6 +13,13 @@ namespace curvesfm {
 
 // The pieces of the commands' report.json files that several commands share.
 
+/// The program's version and the git commit it was built from, as {"version": "0.1.0",
+/// "commit": "abc1234"}: the version is CMake's project(VERSION), the commit
+/// `git rev-parse --short HEAD` of the source tree when it was last built ("unknown" outside a
+/// git checkout, e.g. a tarball). `curvesfm --version` prints both; report.json holds this
+/// object under "curvesfm".
+nlohmann::json versionJson();
+
 /// An OptimizationSummary as a JSON object (for report.json).
 nlohmann::json summaryToJson(const OptimizationSummary& summary);
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/cli/report_json.h"
 #include "core/dataset_io.h"
 #include "sim/planar_scene.h"
 #include "test/apps/run_command_fixture.h"
@@ -60,6 +61,7 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   }
   std::ifstream report_file(out + "/report.json");
   const nlohmann::json report = nlohmann::json::parse(report_file);
+  EXPECT_EQ(report["curvesfm"], versionJson());
   EXPECT_EQ(report["counts"]["keyframes"], 6);
   EXPECT_GT(report["counts"]["curves"].get<int>(), 0);
   // Every final curve was started once; extensions add none.

@@ -104,6 +104,9 @@ TEST_F(SynthCommandTest, BadValuesAreUsageErrorsNamingTheOption) {
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output,
               HasSubstr("--frames = 1: must be >= 2 (PlanarSceneOptions.num_frames)"));
+  result = runCurvesfm(flags + " --frames 100000");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--frames = 100000: must be <= 4660 "));
   result = runCurvesfm(flags + " --init-noise-model gaussian");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("expected one of independent, drift"));

@@ -97,6 +97,31 @@ TEST(PlanarSceneOptions, RejectionNamesFieldValueAndConstraint) {
   EXPECT_THROW(makePlanarScene(smoothTexture(8, 8), options), InvalidOptions);
 }
 
+TEST(PlanarSceneOptions, FramesAreBoundedByTheMemoryTheViewsHold) {
+  // 4 GiB of colour views: 4,294,967,296 / (640 x 480 x 3) = 4660.3; 805 MB per 16384^2 view.
+  EXPECT_EQ(maxPlanarFrames(640, 480), 4660);
+  EXPECT_EQ(maxPlanarFrames(1280, 960), 1165);
+  EXPECT_EQ(maxPlanarFrames(16384, 16384), 5);
+  EXPECT_EQ(maxPlanarFrames(16, 12), kMaxPlanarFrames);
+
+  PlanarSceneOptions options;
+  options.num_frames = 4660;
+  EXPECT_EQ(validationMessage(options), "valid");
+  options.num_frames = 4661;
+  EXPECT_EQ(validationMessage(options),
+            "InvalidOptions: PlanarSceneOptions.num_frames = 4661: must be <= 4660 for 640x480 "
+            "views (at most 10000, and the views held in memory, frames x width x height x 3 "
+            "bytes, within 4 GiB)");
+  options.num_frames = 100000;
+  EXPECT_THROW(makePlanarScene(smoothTexture(8, 8), options), InvalidOptions);
+  options = smallOptions();
+  options.width = 16;
+  options.height = 12;
+  options.num_frames = kMaxPlanarFrames + 1;
+  EXPECT_NE(validationMessage(options).find("num_frames = 10001: must be <= 10000 for 16x12"),
+            std::string::npos);
+}
+
 TEST(PlanarTexture, LongerSideSpansThePlaneWidthCentredWithTopAtPlusY) {
   const PlanarTexture texture = makePlanarTexture(cv::Mat(300, 400, CV_8UC3), 2.0);
   EXPECT_DOUBLE_EQ(texture.width_m, 2.0);

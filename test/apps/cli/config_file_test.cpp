@@ -71,6 +71,46 @@ TEST_F(ConfigFileTest, BadFlagValueAndNestingAreRejected) {
   EXPECT_NE(messageOf(write("kernel:\n  type: huber\n")).find("nested mapping"), std::string::npos);
 }
 
+// No flag takes several values, so a list is an error wherever it stands, naming the line where
+// the list starts and the key.
+TEST_F(ConfigFileTest, FlowListIsAnErrorNamingFileLineAndKey) {
+  const std::string path = write("verbose: true\nkernel: [huber, cauchy]\n");
+  EXPECT_EQ(messageOf(path),
+            "ParseError: " + path + ":2: expected a single value for flag 'kernel', found a list");
+}
+
+TEST_F(ConfigFileTest, BlockListIsAnErrorNamingFileLineAndKey) {
+  const std::string path = write("kernel: huber\nmax-iterations:\n  - 3\n  - 4\n");
+  const std::string message = messageOf(path);
+  EXPECT_EQ(message.rfind("ParseError: " + path + ":3: ", 0), 0u) << message;
+  EXPECT_NE(message.find("a single value for flag 'max-iterations', found a list"),
+            std::string::npos)
+      << message;
+  // A switch given as a list is refused the same way, not read as true or false.
+  EXPECT_NE(messageOf(write("verbose:\n  - true\n"))
+                .find(":2: expected a single value for flag "
+                      "'verbose', found a list"),
+            std::string::npos);
+}
+
+TEST_F(ConfigFileTest, RepeatedKeyIsAnErrorNamingFileLineAndKey) {
+  const std::string path = write("kernel: huber\nmax-iterations: 3\nkernel: cauchy\n");
+  EXPECT_EQ(messageOf(path), "ParseError: " + path +
+                                 ":3: expected each flag once, found 'kernel' again (first on "
+                                 "line 1)");
+  // Switches too: yaml-cpp keeps both entries, and neither may silently win.
+  EXPECT_NE(messageOf(write("verbose: true\nverbose: false\n"))
+                .find("config.yaml:2: expected each flag once, found 'verbose' again"),
+            std::string::npos);
+}
+
+TEST_F(ConfigFileTest, KeyThatIsNotANameIsAnErrorNamingFileAndLine) {
+  const std::string message = messageOf(write("kernel: huber\n[max-iterations]: 3\n"));
+  EXPECT_NE(message.find("config.yaml:2: expected a flag name as key, found a list"),
+            std::string::npos)
+      << message;
+}
+
 TEST_F(ConfigFileTest, MissingFileIsAnIoError) {
   EXPECT_THROW(configFileArguments((folder_ / "absent.yaml").string(), *command_), IoError);
 }

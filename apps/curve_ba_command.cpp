@@ -140,6 +140,7 @@ int CurveBaCommand::run() const {
 
   if (!report_path_.empty()) {
     writeReport(report_path_, {{"command", "curve-ba"},
+                               {"curvesfm", versionJson()},
                                {"config", optionsToJson(*command_)},
                                {"options", table_.toJson()},
                                {"scene", sceneCountsToJson(scene)},

@@ -174,6 +174,7 @@ int EvalCommand::run() const {
     writeJsonFile(
         json_path,
         {{"command", "eval"},
+         {"curvesfm", versionJson()},
          {"config", optionsToJson(*command_)},
          {"estimate", {{"path", estimate_path_}, {"poses", evaluation.estimate_poses}}},
          {"ground_truth", {{"path", ground_truth_path_}, {"poses", evaluation.ground_truth_poses}}},

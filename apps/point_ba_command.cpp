@@ -73,6 +73,7 @@ int PointBaCommand::run() const {
   if (!report_path_.empty()) {
     const nlohmann::json report = {
         {"command", "point-ba"},
+        {"curvesfm", versionJson()},
         {"config", optionsToJson(*command_)},
         {"options", table_.toJson()},
         {"scene",

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "apps/cli/report_json.h"
 #include "test/apps/curve_ba_command_fixture.h"
 
 namespace curvesfm {
@@ -33,6 +34,11 @@ TEST_F(CurveBaCommandTest, ConfigFileSetsEnumsAndBoolsAndFlagsWin) {
   EXPECT_EQ(options["scene"]["num_keyframes"], 3);
   EXPECT_EQ(report["config"]["lambda1"], "9");
   EXPECT_EQ(report["config"]["subpixel-edges"], "false");
+  EXPECT_EQ(report["curvesfm"], versionJson());
+  // Every field of the objective, the motion prior's included, and the derived gauge switch.
+  EXPECT_EQ(options["bundle_adjustment"]["motion_prior_rotation_sigma_deg"], 0.02);
+  EXPECT_EQ(options["scheduler"]["fix_first_pose"], true);
+  EXPECT_EQ(options["scene"]["intrinsics"]["width"], 640);
 }
 
 TEST_F(CurveBaCommandTest, UnknownEnumValueNamesTheFlagAndTheAcceptedNames) {

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
+#include "apps/cli/report_json.h"
 #include "test/support/run_executable.h"
 
 namespace curvesfm {
@@ -67,6 +68,7 @@ TEST_F(EvalCommandTest, PrintsMatchesAteAndRpeAndWritesJsonAndPlot) {
   const nlohmann::json report = nlohmann::json::parse(json_file);
   EXPECT_EQ(report["matched"], 40);
   EXPECT_EQ(report["options"]["alignment"], "sim3");
+  EXPECT_EQ(report["curvesfm"], versionJson());
   EXPECT_NEAR(report["alignment"]["scale"].get<double>(), 2.0, 1e-4);
   EXPECT_LT(report["ate_m"]["rmse"].get<double>(), 1e-4);
   EXPECT_EQ(report["ate_m"]["count"], 40);

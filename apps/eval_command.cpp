@@ -19,13 +19,12 @@
 #include "apps/cli/option_tables.h"
 #include "apps/cli/plot_scripts.h"
 #include "apps/cli/report_json.h"
+#include "core/angles.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
 
 namespace curvesfm {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 double rotationAngleDeg(const Eigen::Matrix3d& rotation) {
   return Eigen::AngleAxisd(rotation).angle() * kRadToDeg;

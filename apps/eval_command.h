@@ -11,7 +11,7 @@ namespace curvesfm {
 /// `curvesfm eval`: compares an estimated TUM trajectory with the ground truth: associates the
 /// poses by timestamp, aligns the estimate (sim3, se3 or none) and prints the ATE and RPE
 /// statistics; optionally writes them as JSON and draws the trajectories and the error as a PNG
-/// or PDF (`--plot`, by `python3 -m curvesfm_plots eval` from that JSON: apps/plot_scripts.h).
+/// or PDF (`--plot`, by `python3 -m curvesfm_plots eval` from that JSON: apps/cli/plot_scripts.h).
 class EvalCommand {
  public:
   explicit EvalCommand(CLI::App* app);

@@ -8,7 +8,7 @@ namespace curvesfm {
 /// `curvesfm report RUN_DIR [--out FILE.html]`: the self-contained interactive HTML report of one
 /// `curvesfm run` output folder (3D curve map with keyframe frusta, trajectories against the
 /// ground truth, ATE over time, per-stage timings, costs per factor type, overlay thumbnails),
-/// drawn by `python3 -m curvesfm_plots report` (apps/plot_scripts.h). Default output
+/// drawn by `python3 -m curvesfm_plots report` (apps/cli/plot_scripts.h). Default output
 /// RUN_DIR/report.html.
 class ReportCommand {
  public:

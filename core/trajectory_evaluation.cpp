@@ -6,13 +6,12 @@
 #include <sstream>
 #include <tuple>
 
+#include "core/angles.h"
 #include "core/check.h"
 #include "core/so3.h"
 
 namespace curvesfm {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // The camera centres (world_from_cam translations) of the matched poses of one trajectory, as
 // columns; `side` picks the index into `poses` from a match.

@@ -14,6 +14,7 @@
 #include <string>
 #include <utility>
 
+#include "core/angles.h"
 #include "core/bezier_fit.h"
 #include "core/check.h"
 #include "core/errors.h"
@@ -23,7 +24,6 @@
 namespace curvesfm {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kBackground = 128.0;
 // Dense samples per segment (shared end samples included) fitted by BezierFitter.
 constexpr int kFitSamplesPerSegment = 32;

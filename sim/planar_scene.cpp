@@ -11,6 +11,7 @@
 #include <sstream>
 #include <system_error>
 
+#include "core/angles.h"
 #include "core/check.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
@@ -18,7 +19,6 @@
 namespace curvesfm {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 // Far beyond any real camera; it keeps a mistyped size from allocating gigabytes per frame.
 constexpr int kMaxImageSide = 16384;
 

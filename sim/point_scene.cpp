@@ -4,14 +4,13 @@
 #include <cmath>
 #include <random>
 
+#include "core/angles.h"
 #include "core/errors.h"
 #include "core/so3.h"
 #include "core/trajectory_evaluation.h"
 
 namespace curvesfm {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // Camera at `centre` looking at the origin, image y pointing along world +y ("down").
 Pose3 lookAtOrigin(const Eigen::Vector3d& centre) {

@@ -14,24 +14,17 @@ namespace {
 // "x,y,z" for a vector flag; InvalidOptions naming `struct_name`.`field` for anything else.
 Eigen::Vector3d parseVector3(const std::string& text, const std::string& struct_name,
                              const std::string& field) {
-  std::vector<double> values;
-  std::stringstream in(text);
+  std::istringstream in(text);
   in.imbue(std::locale::classic());
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    std::size_t used = 0;
-    try {
-      values.push_back(std::stod(item, &used));
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size()) values.clear(), values.resize(4);
-  }
-  if (values.size() != 3) {
+  Eigen::Vector3d v;
+  char comma1 = 0, comma2 = 0;
+  in >> v.x() >> comma1 >> v.y() >> comma2 >> v.z();
+  const bool whole = in && (in >> std::ws).eof();
+  if (!whole || comma1 != ',' || comma2 != ',' || !v.allFinite()) {
     throw InvalidOptions(struct_name, field, "\"" + text + "\"",
                          "expected three numbers \"x,y,z\"");
   }
-  return {values[0], values[1], values[2]};
+  return v;
 }
 
 std::string printVector3(const Eigen::Vector3d& v) {

@@ -8,7 +8,7 @@ namespace curvesfm {
 // The C++ programs write data (CSV, JSON, PLY, TUM); the figures and the HTML report are drawn by
 // the Python package scripts/curvesfm_plots (matplotlib, plotly). These helpers run it as
 // `<python> -m curvesfm_plots <arguments>` with PYTHONPATH set to the repository's scripts folder,
-// both fixed at configure time (apps/CMakeLists.txt: CURVESFM_PYTHON, CURVESFM_SCRIPTS_DIR).
+// both fixed at configure time (apps/cli/CMakeLists.txt: CURVESFM_PYTHON, CURVESFM_SCRIPTS_DIR).
 
 /// The command line that runs the package with `arguments`, shell-quoted, for messages that tell
 /// the user how to draw the figures by hand.

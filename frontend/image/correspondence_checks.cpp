@@ -5,13 +5,13 @@
 #include <limits>
 #include <sstream>
 
+#include "core/angles.h"
 #include "core/check.h"
 #include "core/errors.h"
 
 namespace curvesfm {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 // Image tangents shorter than this (px per unit t) give no usable normal: the segment is seen
 // end-on, and its band shrinks to the sample itself.
 constexpr double kMinImageTangent = 1e-9;

@@ -2,12 +2,11 @@
 
 #include <cmath>
 
+#include "core/angles.h"
 #include "core/errors.h"
 
 namespace curvesfm {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 std::optional<Eigen::Vector2d> projectWorld(const Eigen::Vector3d& point_in_world,
                                             const Pose3& cam_from_world, const Camera& camera) {

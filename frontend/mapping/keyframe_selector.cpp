@@ -2,10 +2,10 @@
 
 #include <cmath>
 
+#include "core/angles.h"
+
 namespace curvesfm {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 double rotationAngleDeg(const Pose3& a, const Pose3& b) {
   return a.rotation().angularDistance(b.rotation()) * kRadToDeg;

@@ -54,16 +54,19 @@ def numbers(document, path, key_path, width=None):
     return values
 
 
+def _read_lines(path):
+    try:
+        with open(path) as f:
+            return f.read().splitlines()
+    except OSError as e:
+        raise InputError("%s: cannot read: %s" % (path, e.strerror))
+
+
 def read_obj(path):
     """Curves of a curvesfm curves.obj: [(name, [polyline, ...])], a polyline being a list of
     (x, y, z) from one `l` line of 1-based vertex indices, grouped by the `o` line before it."""
     vertices, curves = [], []
-    try:
-        with open(path) as f:
-            lines = f.read().splitlines()
-    except OSError as e:
-        raise InputError("%s: cannot read: %s" % (path, e.strerror))
-    for number, line in enumerate(lines, 1):
+    for number, line in enumerate(_read_lines(path), 1):
         words = line.split()
         if not words or words[0].startswith("#"):
             continue
@@ -107,12 +110,7 @@ def _indices(words, count, where):
 def read_tum(path):
     """A TUM trajectory: [(timestamp, (tx, ty, tz), (qx, qy, qz, qw))], camera-to-world."""
     poses = []
-    try:
-        with open(path) as f:
-            lines = f.read().splitlines()
-    except OSError as e:
-        raise InputError("%s: cannot read: %s" % (path, e.strerror))
-    for number, line in enumerate(lines, 1):
+    for number, line in enumerate(_read_lines(path), 1):
         words = line.split()
         if not words or words[0].startswith("#"):
             continue

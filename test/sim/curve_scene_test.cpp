@@ -9,13 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "core/angles.h"
 #include "core/errors.h"
 #include "core/trajectory_evaluation.h"
 
 namespace curvesfm {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 std::string validationMessage(const CurveSceneOptions& options) {
   try {

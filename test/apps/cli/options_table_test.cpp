@@ -154,5 +154,29 @@ TEST_F(PipelineTableTest, JsonMirrorsTheStructsAndHelpHasAHeadingPerStage) {
   }
 }
 
+TEST(OptionsTable, VectorFlagsTakeThreeNumbersAndNameTheFlagOtherwise) {
+  CLI::App app;
+  CurveSceneOptions scene;
+  CurveOverlayOptions overlay;
+  OptionsTable table;
+  addCurveSceneOptions(&table, &scene, {"/scene", "", "Scene", ""});
+  addCurveOverlayOptions(&table, &overlay, {"/overlay", "overlay-", "Overlays", ""});
+  table.addFlags(&app);
+  parseCommandLine(&app, {"--volume-half-extents", "1,2.5,3", "--overlay-colour", "0,0,255"});
+  EXPECT_EQ(scene.volume_half_extents, Eigen::Vector3d(1.0, 2.5, 3.0));
+  EXPECT_EQ(overlay.colour, cv::Scalar(0, 0, 255));
+  EXPECT_EQ(table.toJson()["scene"]["volume_half_extents"], "1,2.5,3");
+  for (const char* bad : {"1,2", "1,2,3,4", "1;2;3", "1,2,x", "1,2,inf"}) {
+    app.clear();
+    try {
+      parseCommandLine(&app, {"--volume-half-extents", bad});
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const CLI::ParseError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("--volume-half-extents")) << bad;
+      EXPECT_THAT(e.what(), HasSubstr("expected three numbers")) << bad;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace curvesfm

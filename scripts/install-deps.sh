@@ -9,6 +9,7 @@ PACKAGES=(
   libeigen3-dev
   libceres-dev libsuitesparse-dev libgoogle-glog-dev libgflags-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev
+  libopencv-features2d-dev libopencv-flann-dev libopencv-calib3d-dev libopencv-video-dev
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   opencv-doc

@@ -10,6 +10,7 @@
 #include "core/angles.h"
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/so3.h"
 
 namespace curvesfm {
 
@@ -262,6 +263,72 @@ std::vector<Hypothesis> homographyHypotheses(const Eigen::Matrix3d& H, const Eig
   return out;
 }
 
+// Sampson errors (px, through `focal`) of normalized matches xa <-> xb under E = [t]x R.
+Eigen::VectorXd sampsonErrors(const std::vector<Eigen::Vector3d>& xa,
+                              const std::vector<Eigen::Vector3d>& xb, const Eigen::Matrix3d& R,
+                              const Eigen::Vector3d& t, double focal) {
+  const Eigen::Matrix3d E = so3::hat(t) * R;
+  Eigen::VectorXd r(xa.size());
+  for (size_t i = 0; i < xa.size(); ++i) {
+    const Eigen::Vector3d Ea = E * xa[i], Etb = E.transpose() * xb[i];
+    const double norm2 = Ea.head<2>().squaredNorm() + Etb.head<2>().squaredNorm();
+    r[i] = norm2 > 0.0 ? focal * xb[i].dot(Ea) / std::sqrt(norm2) : 0.0;
+  }
+  return r;
+}
+
+// The minimal-sample model is only as good as its five or four points; a few damped Gauss-Newton
+// steps on the Sampson error of the winner's points use all of them. Parameters: a rotation on
+// the left and a step of t in the plane orthogonal to it (t stays unit). Numerical Jacobian: five
+// columns over a few hundred points, cheap beside the fits.
+void refineMotion(const Eigen::Matrix3d& K, const std::vector<Eigen::Vector2d>& a,
+                  const std::vector<Eigen::Vector2d>& b, const std::vector<int>& indices,
+                  Eigen::Matrix3d* R, Eigen::Vector3d* t) {
+  if (indices.size() < 6) return;
+  const Eigen::Matrix3d K_inv = K.inverse();
+  std::vector<Eigen::Vector3d> xa, xb;
+  for (const int i : indices) {
+    xa.push_back(K_inv * a[i].homogeneous());
+    xb.push_back(K_inv * b[i].homogeneous());
+  }
+  const double focal = 0.5 * (K(0, 0) + K(1, 1));
+  using Vector5d = Eigen::Matrix<double, 5, 1>;
+  const auto apply = [](const Eigen::Matrix3d& R0, const Eigen::Vector3d& t0, const Vector5d& d,
+                        Eigen::Matrix3d* R1, Eigen::Vector3d* t1) {
+    const Eigen::Vector3d u = t0.unitOrthogonal(), v = t0.cross(u);
+    *R1 = so3::exp(d.head<3>()).toRotationMatrix() * R0;
+    *t1 = (t0 + d[3] * u + d[4] * v).normalized();
+  };
+  Eigen::VectorXd r = sampsonErrors(xa, xb, *R, *t, focal);
+  double lambda = 1e-4;
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    Eigen::MatrixXd J(r.size(), 5);
+    for (int k = 0; k < 5; ++k) {
+      const double h = 1e-7;
+      Eigen::Matrix3d Rp, Rm;
+      Eigen::Vector3d tp, tm;
+      apply(*R, *t, h * Vector5d::Unit(k), &Rp, &tp);
+      apply(*R, *t, -h * Vector5d::Unit(k), &Rm, &tm);
+      J.col(k) =
+          (sampsonErrors(xa, xb, Rp, tp, focal) - sampsonErrors(xa, xb, Rm, tm, focal)) / (2.0 * h);
+    }
+    Eigen::Matrix<double, 5, 5> A = J.transpose() * J;
+    A.diagonal() *= 1.0 + lambda;
+    const Vector5d step = A.ldlt().solve(-J.transpose() * r);
+    Eigen::Matrix3d R_new;
+    Eigen::Vector3d t_new;
+    apply(*R, *t, step, &R_new, &t_new);
+    const Eigen::VectorXd r_new = sampsonErrors(xa, xb, R_new, t_new, focal);
+    if (!step.allFinite() || !(r_new.squaredNorm() < r.squaredNorm())) {
+      lambda *= 10.0;
+      continue;
+    }
+    *R = R_new, *t = t_new, r = r_new;
+    lambda = std::max(lambda / 10.0, 1e-8);
+    if (step.norm() < 1e-10) break;
+  }
+}
+
 // The median and the rank-th largest angle (the smallest when there are fewer).
 void parallaxStatistics(std::vector<double> angles, int rank, TwoViewGeometry* out) {
   if (angles.empty()) return;
@@ -291,19 +358,25 @@ TwoViewGeometry decomposeAndGate(const Eigen::Matrix3d& K, const Eigen::Matrix3d
     if (hypotheses[k].points.size() > hypotheses[best].points.size()) best = k;
   }
   if (hypotheses.empty()) return reject(std::move(out), TwoViewRejection::kNoModel);
-  Hypothesis& winner = hypotheses[best];
+  // Refined and re-triangulated; kept only if it keeps at least as many points.
+  Hypothesis refined{hypotheses[best].R, hypotheses[best].t, {}, {}, {}};
+  refineMotion(K, a, b, hypotheses[best].indices, &refined.R, &refined.t);
+  triangulateHypothesis(K, a, b, out.inliers, options.max_reprojection_error_px, &refined);
+  Hypothesis& winner =
+      refined.points.size() >= hypotheses[best].points.size() ? refined : hypotheses[best];
   out.cam_b_from_cam_a = Pose3(winner.R, winner.t);
   parallaxStatistics(winner.angles_deg, options.parallax_rank, &out);
   out.points_in_cam_a = std::move(winner.points);
   out.point_indices = std::move(winner.indices);
 
-  const int num_best = out.hypothesis_votes[best];
+  const int num_best = static_cast<int>(out.points_in_cam_a.size());
   const double needed = std::max<double>(options.min_triangulated_points,
                                          options.min_triangulated_fraction * out.num_inliers);
   if (num_best == 0 || num_best < needed)
     return reject(std::move(out), TwoViewRejection::kTooFewPoints);
   for (size_t k = 0; k < hypotheses.size(); ++k) {
-    if (k != best && out.hypothesis_votes[k] > options.clear_winner_ratio * num_best) {
+    if (k != best &&
+        out.hypothesis_votes[k] > options.clear_winner_ratio * out.hypothesis_votes[best]) {
       return reject(std::move(out), TwoViewRejection::kAmbiguousDecomposition);
     }
   }

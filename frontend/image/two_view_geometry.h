@@ -26,8 +26,7 @@ namespace curvesfm {
 //     USAC's own error measure (its mask is not used).
 //  3. Select H when R_H = S_H / (S_H + S_E) > homography_score_ratio (ORB-SLAM: 0.40 in ORB2,
 //     0.50 in ORB3) or when H has more than homography_inlier_ratio times E's inliers
-//     (COLMAP's planar/panoramic rule, 0.8); else E. The pose is the fitted model's, not refined
-//     over all inliers: two-view bundle adjustment follows in the initialiser.
+//     (COLMAP's planar/panoramic rule, 0.8); else E.
 //  4. Pure rotation: the rotation nearest to K^-1 H K (R = U V^T of its SVD) transfers at least
 //     pure_rotation_fraction of the selected model's inliers within H's inlier bound (2.45 sigma,
 //     step 2). Then no translation is observable (COLMAP's "panoramic"), and the pair is rejected
@@ -36,12 +35,16 @@ namespace curvesfm {
 //     (R, t, n) (cv::decomposeHomographyMat). Each hypothesis triangulates the selected model's
 //     inliers (linear DLT on normalized coordinates) and counts the points that pass the gates:
 //     finite, depth > Camera::kMinDepth in both frames, reprojection error at most
-//     max_reprojection_error_px in both images.
+//     max_reprojection_error_px in both images. The winner (most points) is refined by ten damped
+//     Gauss-Newton steps on the Sampson error of its points (E = [t]x R for either model; it only
+//     polishes the minimal-sample fit, two-view bundle adjustment follows in the initialiser) and
+//     re-triangulated; the refinement is kept when it keeps at least as many points. The vote
+//     itself compares the unrefined hypotheses.
 //  6. Accept only (ORB-SLAM's CheckRT / ReconstructF / ReconstructH) when, checked in this order,
-//     - the winner (most points) triangulates >= max(min_triangulated_points,
+//     - the winner triangulates >= max(min_triangulated_points,
 //       min_triangulated_fraction x inliers) points (ORB-SLAM: 50 and 0.9); else too_few_points;
 //     - it is the one clear winner: no other hypothesis counts more than clear_winner_ratio x its
-//       points (ORB-SLAM: 0.7 for E, 0.75 for H); else ambiguous_decomposition;
+//       vote (ORB-SLAM: 0.7 for E, 0.75 for H); else ambiguous_decomposition;
 //     - the parallax_rank-th largest triangulation angle is >= min_parallax_deg (ORB-SLAM: the
 //       51st largest above 1 deg) and the median angle >= min_median_parallax_deg (COLMAP's
 //       initial pair: 16 deg; off by default, for a pair search to set); else low_parallax.

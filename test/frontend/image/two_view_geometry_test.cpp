@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "core/angles.h"
@@ -138,6 +139,8 @@ TEST(TwoViewGeometry, PlanarSceneWithTwoValidTwinsIsRejectedAsAmbiguous) {
   EXPECT_EQ(g.model, TwoViewModel::kHomography);
   EXPECT_FALSE(g.accepted);
   EXPECT_EQ(g.rejection, TwoViewRejection::kAmbiguousDecomposition) << toString(g.rejection);
+  // The twin the vote happened to rank first is far from the truth: guessing would be wrong.
+  EXPECT_GT(rotationErrorDeg(g.cam_b_from_cam_a, truth), 5.0);
 }
 
 TEST(TwoViewGeometry, PureRotationIsRejected) {
@@ -146,6 +149,33 @@ TEST(TwoViewGeometry, PureRotationIsRejected) {
   const TwoViewGeometry g = estimateTwoViewGeometry(testCamera(), scene.a, scene.b, {});
   EXPECT_FALSE(g.accepted);
   EXPECT_EQ(g.rejection, TwoViewRejection::kPureRotation) << toString(g.rejection);
+}
+
+// The single-seed tests above, over twenty more seeds of noise, outliers and points.
+TEST(TwoViewGeometry, DecisionsHoldOverTwentySeeds) {
+  const Pose3 general = motion({0.02, -0.04, 0.01}, {0.3, 0.02, 0.05});
+  const Pose3 sideways = motion({0.03, -0.05, 0.02}, {0.6, 0.1, 0.0});
+  const Pose3 towards = motion({0.03, -0.05, 0.02}, {0.6, 0.1, 0.8});
+  const Pose3 rotation = motion({0.03, -0.06, 0.02}, Eigen::Vector3d::Zero());
+  for (unsigned seed = 100; seed < 120; ++seed) {
+    for (const auto& [truth, scene, model] :
+         {std::tuple{general, generalScene(general, 0.1, seed), TwoViewModel::kEssential},
+          std::tuple{sideways, planarScene(sideways, seed), TwoViewModel::kHomography}}) {
+      const TwoViewGeometry g = estimateTwoViewGeometry(testCamera(), scene.a, scene.b, {});
+      ASSERT_TRUE(g.accepted) << "seed " << seed << ": " << toString(g.rejection);
+      EXPECT_EQ(g.model, model) << "seed " << seed;
+      EXPECT_LT(rotationErrorDeg(g.cam_b_from_cam_a, truth), 0.5) << "seed " << seed;
+      EXPECT_LT(directionErrorDeg(g.cam_b_from_cam_a, truth), 2.0) << "seed " << seed;
+    }
+    const Scene twins = planarScene(towards, seed);
+    EXPECT_EQ(estimateTwoViewGeometry(testCamera(), twins.a, twins.b, {}).rejection,
+              TwoViewRejection::kAmbiguousDecomposition)
+        << "seed " << seed;
+    const Scene turn = generalScene(rotation, 0.1, seed);
+    EXPECT_EQ(estimateTwoViewGeometry(testCamera(), turn.a, turn.b, {}).rejection,
+              TwoViewRejection::kPureRotation)
+        << "seed " << seed;
+  }
 }
 
 TEST(TwoViewGeometry, TooFewMatchesAreRejected) {

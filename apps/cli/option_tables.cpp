@@ -472,6 +472,41 @@ void addPlanarSceneOptions(OptionsTable* table, PlanarSceneOptions* o, const Opt
       .number("arc_degrees", "arc", &o->arc_degrees, "Orbit arc spanned by the views (deg)");
 }
 
+void addTwoViewOptions(OptionsTable* table, TwoViewOptions* o, const OptionPlace& place) {
+  table->group(o, "TwoViewOptions", place.path, place.prefix, place.heading)
+      .number("min_matches", "min-matches", &o->min_matches, "Fewest matches worth fitting")
+      .enumeration("robust_score", "robust-score", &o->robust_score,
+                   "USAC score of the E and H fits")
+      .number("ransac_threshold_px", "ransac-threshold", &o->ransac_threshold_px,
+              "USAC inlier threshold of the E and H fits (px)")
+      .number("confidence", "confidence", &o->confidence, "USAC confidence")
+      .number("max_iterations", "max-iterations", &o->max_iterations, "Most USAC iterations")
+      .number("seed", "seed", &o->seed, "USAC random seed")
+      .number("score_sigma_px", "score-sigma", &o->score_sigma_px,
+              "Pixel noise of the ORB-SLAM scores and inliers (px)")
+      .number("homography_score_ratio", "homography-score-ratio", &o->homography_score_ratio,
+              "Select H when S_H / (S_H + S_E) exceeds this (ORB-SLAM)")
+      .number("homography_inlier_ratio", "homography-inlier-ratio", &o->homography_inlier_ratio,
+              "Select H when its inliers exceed this times E's (COLMAP)")
+      .number("pure_rotation_fraction", "pure-rotation-fraction", &o->pure_rotation_fraction,
+              "Pure rotation when a rotation alone explains this fraction of the inliers")
+      .number("clear_winner_ratio", "clear-winner-ratio", &o->clear_winner_ratio,
+              "Ambiguous when a second decomposition keeps more than this fraction of the "
+              "winner's points")
+      .number("min_triangulated_points", "min-points", &o->min_triangulated_points,
+              "Fewest triangulated points")
+      .number("min_triangulated_fraction", "min-triangulated-fraction",
+              &o->min_triangulated_fraction, "Fewest triangulated points as a fraction of inliers")
+      .number("max_reprojection_error_px", "max-reprojection-error", &o->max_reprojection_error_px,
+              "Largest reprojection error of a triangulated point (px)")
+      .number("parallax_rank", "parallax-rank", &o->parallax_rank,
+              "Which largest triangulation angle the parallax gate reads (ORB-SLAM: 51)")
+      .number("min_parallax_deg", "min-parallax", &o->min_parallax_deg,
+              "Smallest accepted parallax-rank-th largest triangulation angle (deg)")
+      .number("min_median_parallax_deg", "min-median-parallax", &o->min_median_parallax_deg,
+              "Smallest accepted median triangulation angle (deg); 0 is off");
+}
+
 void addTrajectoryEvaluationOptions(OptionsTable* table, TrajectoryEvaluationOptions* o,
                                     const OptionPlace& place) {
   table->group(o, "TrajectoryEvaluationOptions", place.path, place.prefix, place.heading)

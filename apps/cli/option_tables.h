@@ -8,6 +8,7 @@
 #include "factors/curve_bundle_adjustment.h"
 #include "factors/point_bundle_adjustment.h"
 #include "frontend/image/curve_overlay.h"
+#include "frontend/image/two_view_geometry.h"
 #include "frontend/mapping/pipeline.h"
 #include "graph/optimizer.h"
 #include "graph/scheduler.h"
@@ -57,6 +58,8 @@ void addPointSceneOptions(OptionsTable* table, PointSceneOptions* options,
 /// cx and cy are not flags: `curvesfm synth planar` centres the principal point.
 void addPlanarSceneOptions(OptionsTable* table, PlanarSceneOptions* options,
                            const OptionPlace& place);
+/// Not wired into a command yet: the initialiser (issue 13) will take it.
+void addTwoViewOptions(OptionsTable* table, TwoViewOptions* options, const OptionPlace& place);
 void addTrajectoryEvaluationOptions(OptionsTable* table, TrajectoryEvaluationOptions* options,
                                     const OptionPlace& place);
 

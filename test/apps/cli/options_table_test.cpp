@@ -31,13 +31,17 @@ struct AllOptions {
   OptimizerOptions optimizer;
   PlanarSceneOptions planar;
   TrajectoryEvaluationOptions evaluation;
+  TwoViewOptions two_view;
 };
 
-// The tables as the commands build them (run, curve-ba, point-ba, synth planar, eval).
+// The tables as the commands build them (run, curve-ba, point-ba, synth planar, eval), with the
+// two-view options in run's table ahead of the initialiser that will use them.
 std::vector<OptionsTable> commandTables(AllOptions* o) {
   std::vector<OptionsTable> tables(5);
   addPipelineOptions(&tables[0], &o->pipeline, "/pipeline");
   addCurveOverlayOptions(&tables[0], &o->overlay, {"/overlay", "overlay-", "Overlays", ""});
+  // Not yet in `run`: the initialiser will take it there.
+  addTwoViewOptions(&tables[0], &o->two_view, {"/two_view", "two-view-", "Two-view geometry", ""});
   addCurveSceneOptions(&tables[1], &o->curve_scene, {"/scene", "", "Scene", ""});
   addCurveBundleAdjustmentOptions(&tables[1], &o->curve_ba, {"/ba", "", "Objective", ""});
   addSchedulerOptions(&tables[1], &o->scheduler, {"/scheduler", "", "Schedule", ""},

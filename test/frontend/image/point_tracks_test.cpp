@@ -108,7 +108,7 @@ TEST(PointTracker, FollowsPlanarViewsWithinAPixelOfTheHomography) {
   std::cout << "PointTracker: " << checked << " tracks in frame " << last << ", "
             << from_first_frame << " from frame 0, " << within_half_px << " within 0.5 px, "
             << within_1px << " within 1 px\n";
-  EXPECT_GE(from_first_frame, 200);  // Most of frame 0's ~288 tracks live through 7 steps.
+  EXPECT_GE(from_first_frame, 200);  // Most of frame 0's tracks (about 280) live through 7 steps.
   // Translation-only KLT drifts under roll (see window_size_px): about 0.08 px a frame here.
   EXPECT_GT(within_1px, 0.9 * checked);
   EXPECT_GT(within_half_px, 0.25 * checked);

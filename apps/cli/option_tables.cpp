@@ -342,6 +342,35 @@ void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* o, const O
               "Radius of the dots at segment ends (px); 0 draws none");
 }
 
+void addPointTrackerOptions(OptionsTable* table, PointTrackerOptions* o, const OptionPlace& place) {
+  table->group(o, "PointTrackerOptions", place.path, place.prefix, place.heading)
+      .number("grid_cols", "grid-cols", &o->grid_cols, "Columns of the corner bucketing grid")
+      .number("grid_rows", "grid-rows", &o->grid_rows, "Rows of the corner bucketing grid")
+      .number("corners_per_cell", "corners-per-cell", &o->corners_per_cell,
+              "Live tracks each grid cell is topped up to")
+      .number("quality_level", "quality-level", &o->quality_level,
+              "Shi-Tomasi quality level within a cell (fraction of its strongest corner)")
+      .number("image_quality_level", "image-quality-level", &o->image_quality_level,
+              "Weakest corner as a fraction of the image's strongest")
+      .number("min_distance_px", "min-distance", &o->min_distance_px,
+              "Shortest distance between a new corner and any track (px)")
+      .number("corner_block_size", "corner-block-size", &o->corner_block_size,
+              "Corner response window (px, odd)")
+      .number("window_size_px", "window", &o->window_size_px, "KLT window side (px, odd)")
+      .number("pyramid_levels", "pyramid-levels", &o->pyramid_levels,
+              "KLT pyramid levels above the image")
+      .number("max_iterations", "max-iterations", &o->max_iterations,
+              "Most KLT iterations per pyramid level")
+      .number("epsilon_px", "epsilon", &o->epsilon_px, "KLT stops below this step (px)")
+      .number("min_eigen_threshold", "min-eigen", &o->min_eigen_threshold,
+              "KLT gives up on flatter windows (OpenCV's minEigThreshold)")
+      .number("max_forward_backward_px", "max-forward-backward", &o->max_forward_backward_px,
+              "Largest forward-backward tracking error (px)")
+      .number("border_px", "border", &o->border_px, "Tracks this close to the border end (px)")
+      .number("min_live_tracks", "min-live-tracks", &o->min_live_tracks,
+              "Detect new corners only while fewer tracks are live");
+}
+
 void addCameraIntrinsics(OptionsTable* table, CameraIntrinsics* k, const OptionPlace& place) {
   table->group(k, "CameraIntrinsics", place.path, place.prefix, place.heading)
       .number("fx", "fx", &k->fx, "Focal length along x (px)")

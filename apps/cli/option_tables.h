@@ -8,6 +8,7 @@
 #include "factors/curve_bundle_adjustment.h"
 #include "factors/point_bundle_adjustment.h"
 #include "frontend/image/curve_overlay.h"
+#include "frontend/image/point_tracks.h"
 #include "frontend/image/two_view_geometry.h"
 #include "frontend/mapping/pipeline.h"
 #include "graph/optimizer.h"
@@ -48,6 +49,8 @@ void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentO
 /// `--local-ba-*`, ...).
 void addPipelineOptions(OptionsTable* table, PipelineOptions* options, const std::string& path);
 void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* options,
+                            const OptionPlace& place);
+void addPointTrackerOptions(OptionsTable* table, PointTrackerOptions* options,
                             const OptionPlace& place);
 void addCameraIntrinsics(OptionsTable* table, CameraIntrinsics* intrinsics,
                          const OptionPlace& place);

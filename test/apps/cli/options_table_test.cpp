@@ -23,6 +23,7 @@ using ::testing::HasSubstr;
 struct AllOptions {
   PipelineOptions pipeline;
   CurveOverlayOptions overlay;
+  PointTrackerOptions point_tracker;
   CurveSceneOptions curve_scene;
   CurveBundleAdjustmentOptions curve_ba;
   SchedulerOptions scheduler;
@@ -40,8 +41,10 @@ std::vector<OptionsTable> commandTables(AllOptions* o) {
   std::vector<OptionsTable> tables(5);
   addPipelineOptions(&tables[0], &o->pipeline, "/pipeline");
   addCurveOverlayOptions(&tables[0], &o->overlay, {"/overlay", "overlay-", "Overlays", ""});
-  // Not yet in `run`: the initialiser will take it there.
+  // Not yet wired into a command: the initialiser (issue 13) will put them in `run` and `init`.
   addTwoViewOptions(&tables[0], &o->two_view, {"/two_view", "two-view-", "Two-view geometry", ""});
+  addPointTrackerOptions(&tables[0], &o->point_tracker,
+                         {"/point_tracker", "points-", "Point tracks", ""});
   addCurveSceneOptions(&tables[1], &o->curve_scene, {"/scene", "", "Scene", ""});
   addCurveBundleAdjustmentOptions(&tables[1], &o->curve_ba, {"/ba", "", "Objective", ""});
   addSchedulerOptions(&tables[1], &o->scheduler, {"/scheduler", "", "Schedule", ""},

@@ -371,6 +371,18 @@ void addPointTrackerOptions(OptionsTable* table, PointTrackerOptions* o, const O
               "Detect new corners only while fewer tracks are live");
 }
 
+void addFeatureMatchingOptions(OptionsTable* table, FeatureMatchingOptions* o,
+                               const OptionPlace& place) {
+  table->group(o, "FeatureMatchingOptions", place.path, place.prefix, place.heading)
+      .enumeration("kind", "kind", &o->kind, "Descriptor detected and matched")
+      .number("max_features", "max-features", &o->max_features,
+              "Most features kept per image, the strongest first")
+      .number("ratio", "ratio", &o->ratio,
+              "Lowe's ratio: nearest over second-nearest descriptor distance below this")
+      .boolean("mutual_check", "mutual-check", &o->mutual_check,
+               "Keep only matches that are each other's nearest both ways");
+}
+
 void addCameraIntrinsics(OptionsTable* table, CameraIntrinsics* k, const OptionPlace& place) {
   table->group(k, "CameraIntrinsics", place.path, place.prefix, place.heading)
       .number("fx", "fx", &k->fx, "Focal length along x (px)")

@@ -8,6 +8,7 @@
 #include "factors/curve_bundle_adjustment.h"
 #include "factors/point_bundle_adjustment.h"
 #include "frontend/image/curve_overlay.h"
+#include "frontend/image/feature_matching.h"
 #include "frontend/image/point_tracks.h"
 #include "frontend/image/two_view_geometry.h"
 #include "frontend/mapping/pipeline.h"
@@ -52,6 +53,8 @@ void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* options,
                             const OptionPlace& place);
 void addPointTrackerOptions(OptionsTable* table, PointTrackerOptions* options,
                             const OptionPlace& place);
+void addFeatureMatchingOptions(OptionsTable* table, FeatureMatchingOptions* options,
+                               const OptionPlace& place);
 void addCameraIntrinsics(OptionsTable* table, CameraIntrinsics* intrinsics,
                          const OptionPlace& place);
 void addCurveSceneOptions(OptionsTable* table, CurveSceneOptions* options,

@@ -24,6 +24,7 @@ struct AllOptions {
   PipelineOptions pipeline;
   CurveOverlayOptions overlay;
   PointTrackerOptions point_tracker;
+  FeatureMatchingOptions feature_matching;
   CurveSceneOptions curve_scene;
   CurveBundleAdjustmentOptions curve_ba;
   SchedulerOptions scheduler;
@@ -45,6 +46,8 @@ std::vector<OptionsTable> commandTables(AllOptions* o) {
   addTwoViewOptions(&tables[0], &o->two_view, {"/two_view", "two-view-", "Two-view geometry", ""});
   addPointTrackerOptions(&tables[0], &o->point_tracker,
                          {"/point_tracker", "points-", "Point tracks", ""});
+  addFeatureMatchingOptions(&tables[0], &o->feature_matching,
+                            {"/feature_matching", "match-features-", "Feature matching", ""});
   addCurveSceneOptions(&tables[1], &o->curve_scene, {"/scene", "", "Scene", ""});
   addCurveBundleAdjustmentOptions(&tables[1], &o->curve_ba, {"/ba", "", "Objective", ""});
   addSchedulerOptions(&tables[1], &o->scheduler, {"/scheduler", "", "Schedule", ""},

@@ -187,6 +187,21 @@ PlanarTexture makePlanarTexture(const cv::Mat& image, double plane_width_m) {
   return {image, image.cols * metres_per_pixel, image.rows * metres_per_pixel};
 }
 
+Eigen::Matrix3d PlanarScene::pixelMap(int from, int to) const {
+  const int frames = static_cast<int>(true_cam_from_world.size());
+  CURVESFM_CHECK(from >= 0 && from < frames && to >= 0 && to < frames)
+      << "frames " << from << " and " << to << " of " << frames;
+  return pixelFromPlane(*camera, true_cam_from_world[to]) *
+         pixelFromPlane(*camera, true_cam_from_world[from]).inverse();
+}
+
+Eigen::Matrix3d pixelFromPlane(const Camera& camera, const Pose3& cam_from_world) {
+  const Eigen::Matrix3d rotation = cam_from_world.rotationMatrix();
+  Eigen::Matrix3d cam_from_plane;
+  cam_from_plane << rotation.col(0), rotation.col(1), cam_from_world.translation();
+  return camera.K() * cam_from_plane;
+}
+
 cv::Mat renderPlanarView(const cv::Mat& texture_bgr, double plane_width_m, const Camera& camera,
                          const Pose3& cam_from_world, int background) {
   CURVESFM_CHECK(!camera.hasDistortion()) << "a homography cannot render lens distortion";
@@ -195,16 +210,15 @@ cv::Mat renderPlanarView(const cv::Mat& texture_bgr, double plane_width_m, const
   const cv::Size size(camera.width(), camera.height());
   const cv::Scalar fill = cv::Scalar::all(background);
 
-  const Eigen::Matrix3d rotation = cam_from_world.rotationMatrix();
-  Eigen::Matrix3d cam_from_plane;
-  cam_from_plane << rotation.col(0), rotation.col(1), cam_from_world.translation();
-  // The determinant is minus the camera's height: a camera in the plane sees it edge-on.
-  if (!(std::abs(cam_from_plane.determinant()) > 1e-12)) {
+  const Eigen::Matrix3d pixel_from_plane = pixelFromPlane(camera, cam_from_world);
+  // The determinant is minus the camera's height times det K: a camera in the plane sees it
+  // edge-on.
+  if (!(std::abs(pixel_from_plane.determinant() / camera.K().determinant()) > 1e-12)) {
     return cv::Mat(size, texture_bgr.type(), fill);
   }
   // Inverted here, unscaled, so that its last row stays the pixel's inverse depth.
   const Eigen::Matrix3d texture_from_image =
-      (camera.K() * cam_from_plane * texture.planeFromTexture()).inverse();
+      (pixel_from_plane * texture.planeFromTexture()).inverse();
   cv::Matx33d map;
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) map(r, c) = texture_from_image(r, c);

@@ -130,6 +130,11 @@ struct PlanarTexture {
 /// The image is shared, not copied. CheckError for an empty image or a non-positive width.
 PlanarTexture makePlanarTexture(const cv::Mat& image, double plane_width_m);
 
+/// The homography K [r1 r2 t] from a point (x, y, 1) of the plane z = 0 (world frame) to the
+/// homogeneous pixel of `camera` at `cam_from_world`: every planar view is this map of the plane,
+/// so two views are related by pixelFromPlane(b) * pixelFromPlane(a)^-1.
+Eigen::Matrix3d pixelFromPlane(const Camera& camera, const Pose3& cam_from_world);
+
 /// Renders what `camera` at `cam_from_world` sees of the photo `texture_bgr` (CV_8UC1 or
 /// CV_8UC3) laid on the plane with its longer side spanning plane_width_m: the homography
 /// K [r1 r2 t] planeFromTexture() applied by cv::warpPerspective with bilinear interpolation
@@ -156,6 +161,8 @@ struct PlanarScene {
 
   /// Mean distance between consecutive true camera centres (m); 0 for fewer than 2 frames.
   double meanFrameBaseline() const;
+  /// The true homography from homogeneous pixels of frame `from` to those of frame `to`.
+  Eigen::Matrix3d pixelMap(int from, int to) const;
   /// Distance between the first and the last true camera centres (m).
   double firstToLastBaseline() const;
 };

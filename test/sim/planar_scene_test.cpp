@@ -185,6 +185,30 @@ TEST(RenderPlanarView, AMarkerOnThePlaneAppearsWhereTheCameraProjectsIt) {
   }
 }
 
+TEST(PlanarScene, PixelMapIsTheHomographyBetweenTwoViewsOfThePlane) {
+  PlanarSceneOptions options;
+  options.num_frames = 5;
+  const PlanarScene scene = makePlanarScene(smoothTexture(40, 30), options);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> coordinate(-0.3, 0.3);
+  for (int i = 0; i < 10; ++i) {
+    const Eigen::Vector3d point(coordinate(rng), coordinate(rng), 0.0);
+    Eigen::Vector2d in_first, in_last;
+    ASSERT_TRUE(scene.camera->project(scene.true_cam_from_world[0] * point, &in_first));
+    ASSERT_TRUE(scene.camera->project(scene.true_cam_from_world[4] * point, &in_last));
+    const Eigen::Vector3d plane_point(point.x(), point.y(), 1.0);
+    EXPECT_LT(
+        ((pixelFromPlane(*scene.camera, scene.true_cam_from_world[0]) * plane_point).hnormalized() -
+         in_first)
+            .norm(),
+        1e-9);
+    EXPECT_LT(((scene.pixelMap(0, 4) * in_first.homogeneous()).hnormalized() - in_last).norm(),
+              1e-9);
+  }
+  EXPECT_LT((scene.pixelMap(2, 2) - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+  EXPECT_THROW(scene.pixelMap(0, 5), CheckError);
+}
+
 TEST(RenderPlanarView, RaysMeetingThePlaneBehindTheCameraSeeTheBackground) {
   // A camera 0.5 m above a huge photo looking at the horizon: the lower half sees the plane in
   // front, the upper half's rays meet the plane behind the camera.

@@ -11,28 +11,12 @@
 
 #include "core/errors.h"
 #include "sim/planar_scene.h"
+#include "test/support/textures.h"
 
 namespace curvesfm {
 namespace {
 
 using ::testing::HasSubstr;
-
-// Many small filled rectangles and discs in random grey levels on a mid-grey ground: blobs and
-// corners everywhere for SIFT and ORB.
-cv::Mat denseTexture() {
-  cv::Mat texture(480, 640, CV_8UC1, cv::Scalar(128));
-  cv::RNG rng(11);
-  for (int i = 0; i < 400; ++i) {
-    const cv::Point a(rng.uniform(0, 640), rng.uniform(0, 480));
-    const cv::Point b(a.x + rng.uniform(8, 40), a.y + rng.uniform(8, 40));
-    cv::rectangle(texture, a, b, cv::Scalar(rng.uniform(0, 256)), cv::FILLED);
-  }
-  for (int i = 0; i < 150; ++i) {
-    cv::circle(texture, {rng.uniform(0, 640), rng.uniform(0, 480)}, rng.uniform(4, 20),
-               cv::Scalar(rng.uniform(0, 256)), cv::FILLED, cv::LINE_AA);
-  }
-  return texture;
-}
 
 // Two 320x240 views of the photo, the ends of a 20 deg arc of the default orbit (0.23 m apart,
 // about 40 px of parallax and 20 deg of roll between them), with a little sensor noise: a
@@ -48,23 +32,15 @@ const PlanarScene& scene() {
     options.fx = options.fy = 262.5;
     options.cx = 159.5;
     options.cy = 119.5;
-    return makePlanarScene(denseTexture(), options);
+    return makePlanarScene(testing::denseTexture(), options);
   }();
   return kScene;
-}
-
-// Plane (x, y, 1) -> pixel of frame k: K [r1 r2 t], the views being homographies of z = 0.
-Eigen::Matrix3d pixelFromPlane(const PlanarScene& s, int k) {
-  const Pose3& pose = s.true_cam_from_world[k];
-  Eigen::Matrix3d rt;
-  rt << pose.rotationMatrix().col(0), pose.rotationMatrix().col(1), pose.translation();
-  return s.camera->K() * rt;
 }
 
 // Matches within 2 px of the true homography from frame 0 to frame 1.
 int agreeing(const std::vector<FeatureMatch>& matches) {
   const PlanarScene& s = scene();
-  const Eigen::Matrix3d b_from_a = pixelFromPlane(s, 1) * pixelFromPlane(s, 0).inverse();
+  const Eigen::Matrix3d b_from_a = s.pixelMap(0, 1);
   int within = 0;
   for (const FeatureMatch& m : matches) {
     within += ((b_from_a * m.pixel_a.homogeneous()).hnormalized() - m.pixel_b).norm() < 2.0;

@@ -11,28 +11,12 @@
 
 #include "core/errors.h"
 #include "sim/planar_scene.h"
+#include "test/support/textures.h"
 
 namespace curvesfm {
 namespace {
 
 using ::testing::HasSubstr;
-
-// Many small filled rectangles and discs in random grey levels on a mid-grey ground: corners
-// everywhere, so that every grid cell of every view has something to track.
-cv::Mat denseTexture() {
-  cv::Mat texture(480, 640, CV_8UC1, cv::Scalar(128));
-  cv::RNG rng(11);
-  for (int i = 0; i < 400; ++i) {
-    const cv::Point a(rng.uniform(0, 640), rng.uniform(0, 480));
-    const cv::Point b(a.x + rng.uniform(8, 40), a.y + rng.uniform(8, 40));
-    cv::rectangle(texture, a, b, cv::Scalar(rng.uniform(0, 256)), cv::FILLED);
-  }
-  for (int i = 0; i < 150; ++i) {
-    cv::circle(texture, {rng.uniform(0, 640), rng.uniform(0, 480)}, rng.uniform(4, 20),
-               cv::Scalar(rng.uniform(0, 256)), cv::FILLED, cv::LINE_AA);
-  }
-  return texture;
-}
 
 // Eight 640x480 views at half the default orbit's spacing, with a little sensor noise: about 6 px
 // of motion and 1.5 deg of roll per frame (45 deg/s at 30 Hz, a brisk hand-held pan). Built once:
@@ -43,17 +27,9 @@ const PlanarScene& scene() {
     options.num_frames = 8;
     options.arc_degrees = 90.0 / 29 * 7 / 2;
     options.intensity_noise = 0.01;
-    return makePlanarScene(denseTexture(), options);
+    return makePlanarScene(testing::denseTexture(), options);
   }();
   return kScene;
-}
-
-// Plane (x, y, 1) -> pixel of frame k: K [r1 r2 t], the views being homographies of z = 0.
-Eigen::Matrix3d pixelFromPlane(const PlanarScene& s, int k) {
-  const Pose3& pose = s.true_cam_from_world[k];
-  Eigen::Matrix3d rt;
-  rt << pose.rotationMatrix().col(0), pose.rotationMatrix().col(1), pose.translation();
-  return s.camera->K() * rt;
 }
 
 Eigen::Vector2d mapPixel(const Eigen::Matrix3d& h, const Eigen::Vector2d& p) {
@@ -96,8 +72,7 @@ TEST(PointTracker, FollowsPlanarViewsWithinAPixelOfTheHomography) {
   for (const auto& [id, observations] : tracks.tracks()) {
     if (observations.back().frame != last) continue;
     const TrackObservation& birth = observations.front();
-    const Eigen::Matrix3d last_from_birth =
-        pixelFromPlane(s, last) * pixelFromPlane(s, birth.frame).inverse();
+    const Eigen::Matrix3d last_from_birth = s.pixelMap(birth.frame, last);
     const double error =
         (mapPixel(last_from_birth, birth.pixel) - observations.back().pixel).norm();
     ++checked;
@@ -274,7 +249,7 @@ TEST(PointTracks, CorrespondencesOfTrackedPlanarViewsAreTrueMatches) {
   for (int k = 0; k < 4; ++k) tracks.add(tracker.track(s.images[k]));
   const std::vector<PointCorrespondence> pairs = tracks.correspondences(0, 3);
   ASSERT_GT(pairs.size(), 150u);
-  const Eigen::Matrix3d h = pixelFromPlane(s, 3) * pixelFromPlane(s, 0).inverse();
+  const Eigen::Matrix3d h = s.pixelMap(0, 3);
   int good = 0;
   for (const PointCorrespondence& c : pairs)
     good += (mapPixel(h, c.pixel_a) - c.pixel_b).norm() < 1.0;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -50,15 +51,22 @@ std::string enumNameList() {
   return list;
 }
 
+/// The value named `name`, or nothing for a name that is not in the table.
+template <class Enum>
+std::optional<Enum> findEnumName(const std::string& name) {
+  for (const auto& [value, entry] : EnumNames<Enum>::kNames) {
+    if (name == entry) return value;
+  }
+  return std::nullopt;
+}
+
 /// The value named `name`. Anything else throws InvalidOptions naming `struct_name`.`field`, the
 /// name given and every accepted one: `InvalidOptions: SchedulerOptions.scope = "wide": expected
 /// one of global, local`.
 template <class Enum>
 Enum parseEnumName(const std::string& name, const std::string& struct_name,
                    const std::string& field) {
-  for (const auto& [value, entry] : EnumNames<Enum>::kNames) {
-    if (name == entry) return value;
-  }
+  if (const std::optional<Enum> value = findEnumName<Enum>(name)) return *value;
   throw InvalidOptions(struct_name, field, "\"" + name + "\"",
                        "expected one of " + enumNameList<Enum>());
 }

@@ -1,8 +1,6 @@
 #include "apps/cli/cli_options.h"
 
 #include <algorithm>
-#include <fstream>
-#include <memory>
 
 #include "apps/cli/config_file.h"
 #include "core/errors.h"

@@ -19,15 +19,11 @@ CLI::Option* addEnumFlag(CLI::App* command, const std::string& name, Enum* targe
   return command
       ->add_option_function<std::string>(
           "--" + name,
-          [target, name](const std::string& value) {
-            *target = parseEnumName<Enum>(value, "flag", name);
-          },
-          description)
+          // The validator below has already accepted the name.
+          [target](const std::string& value) { *target = *findEnumName<Enum>(value); }, description)
       ->check(CLI::Validator(
           [](std::string& value) -> std::string {
-            for (const auto& entry : EnumNames<Enum>::kNames) {
-              if (value == entry.second) return "";
-            }
+            if (findEnumName<Enum>(value)) return "";
             return "\"" + value + "\": expected one of " + enumNameList<Enum>();
           },
           "NAME"))

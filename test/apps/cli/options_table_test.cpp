@@ -116,7 +116,9 @@ TEST(OptionsTable, FlagsAreUniqueWithinACommand) {
     std::set<std::string> flags;
     for (const OptionGroup& group : table.groups()) {
       for (const OptionField& row : group.fields) {
-        if (!row.flag.empty()) EXPECT_TRUE(flags.insert(row.flag).second) << row.flag;
+        if (!row.flag.empty()) {
+          EXPECT_TRUE(flags.insert(row.flag).second) << row.flag;
+        }
       }
     }
   }

@@ -19,45 +19,17 @@
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/text_records.h"
 
 namespace curvesfm {
 namespace {
 
-using Fields = std::vector<std::string_view>;
+using Fields = TextFields;
 
 constexpr char kImageListFormat[] = "timestamp path";
 constexpr char kTrajectoryFormat[] = "timestamp tx ty tz qx qy qz qw";
 constexpr const char* kTrajectoryFieldNames[] = {"timestamp", "tx", "ty", "tz",
                                                  "qx",        "qy", "qz", "qw"};
-constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
-// Longest token quoted verbatim in a message; binary junk must not flood the terminal.
-constexpr std::size_t kMaxQuotedToken = 40;
-
-std::string toString(double value) {
-  std::ostringstream out;
-  out.imbue(std::locale::classic());
-  out << std::setprecision(std::numeric_limits<double>::digits10) << value;
-  return out.str();
-}
-
-std::string quoteToken(std::string_view token) {
-  if (token.size() > kMaxQuotedToken) {
-    return "\"" + std::string(token.substr(0, kMaxQuotedToken)) + "...\"";
-  }
-  return "\"" + std::string(token) + "\"";
-}
-
-std::ifstream openForReading(const std::string& path) {
-  // An ifstream opens a directory without complaint on Linux and only fails on the first read,
-  // which would look like an empty file.
-  std::error_code ignored;
-  if (std::filesystem::is_directory(path, ignored)) {
-    throw IoError(path, "cannot open for reading (it is a directory)");
-  }
-  std::ifstream in(path);
-  if (!in) throw IoError(path, "cannot open for reading");
-  return in;
-}
 
 // Opens `path`, lets write(out) fill it and reports a failed open or write as IoError.
 template <class Write>
@@ -71,72 +43,11 @@ void writeTextFile(const std::string& path, Write&& write) {
   if (!out) throw IoError(path, "write failed");
 }
 
-Fields splitFields(std::string_view line) {
-  // '\r' counts as a blank so that CRLF files parse like LF files.
-  constexpr std::string_view kBlanks = " \t\r\v\f";
-  Fields fields;
-  std::size_t begin = line.find_first_not_of(kBlanks);
-  while (begin != std::string_view::npos) {
-    const std::size_t end = std::min(line.find_first_of(kBlanks, begin), line.size());
-    fields.push_back(line.substr(begin, end - begin));
-    begin = line.find_first_not_of(kBlanks, end);
-  }
-  return fields;
-}
-
-// Calls visit(line_number, fields) for every line that is neither blank nor a comment.
-template <class Visit>
-void forEachRecord(const std::string& path, Visit&& visit) {
-  std::ifstream in = openForReading(path);
-  std::string line;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    std::string_view view(line);
-    if (line_number == 1 && view.substr(0, kUtf8Bom.size()) == kUtf8Bom) {
-      view.remove_prefix(kUtf8Bom.size());
-    }
-    const Fields fields = splitFields(view);
-    if (fields.empty() || fields.front().front() == '#') continue;
-    visit(line_number, fields);
-  }
-  if (in.bad()) throw IoError(path, "read error");
-}
-
-// std::from_chars is locale independent, unlike strtod, whose decimal separator follows the
-// global C locale.
-std::optional<double> parseFiniteNumber(std::string_view token) {
-  // from_chars rejects the leading '+' that strtod and printf("%+f") produce.
-  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') {
-    token.remove_prefix(1);
-  }
-  double value = 0.0;
-  const char* end = token.data() + token.size();
-  const auto [stop, error] = std::from_chars(token.data(), end, value);
-  if (error != std::errc() || stop != end || !std::isfinite(value)) return std::nullopt;
-  return value;
-}
-
-void requireFieldCount(const std::string& path, int line, const Fields& fields, std::size_t count,
-                       const char* format) {
-  if (fields.size() != count) {
-    throw ParseError(path, line, std::to_string(count) + " fields \"" + format + "\"",
-                     std::to_string(fields.size()));
-  }
-}
-
-double numberField(const std::string& path, int line, const Fields& fields, std::size_t index,
-                   const char* name) {
-  if (const std::optional<double> value = parseFiniteNumber(fields[index])) return *value;
-  throw ParseError(path, line, "a number in field " + std::to_string(index + 1) + " (" + name + ")",
-                   quoteToken(fields[index]));
-}
-
 std::string readWholeFile(const std::string& path) {
   std::ifstream in = openForReading(path);
   std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   if (in.bad()) throw IoError(path, "read error");
-  if (text.compare(0, kUtf8Bom.size(), kUtf8Bom) == 0) text.erase(0, kUtf8Bom.size());
+  text.erase(0, text.size() - withoutByteOrderMark(text).size());
   return text;
 }
 
@@ -224,7 +135,7 @@ struct YamlFile {
     }
     const double value = node.real();
     if (!std::isfinite(value)) {
-      throw ParseError(path, line, "key " + key + " (a finite number)", toString(value));
+      throw ParseError(path, line, "key " + key + " (a finite number)", formatNumber(value));
     }
     return value;
   }
@@ -232,7 +143,7 @@ struct YamlFile {
   double positiveNumber(const std::string& key) const {
     const double value = number(key);
     if (value <= 0.0) {
-      throw ParseError(path, lineOfKey(text, key), "key " + key + " > 0", toString(value));
+      throw ParseError(path, lineOfKey(text, key), "key " + key + " > 0", formatNumber(value));
     }
     return value;
   }
@@ -241,7 +152,7 @@ struct YamlFile {
     const double value = number(key);
     if (value < 1.0 || value > std::numeric_limits<int>::max() || value != std::floor(value)) {
       throw ParseError(path, lineOfKey(text, key),
-                       "key " + key + " (a positive whole number of pixels)", toString(value));
+                       "key " + key + " (a positive whole number of pixels)", formatNumber(value));
     }
     return static_cast<int>(value);
   }
@@ -278,8 +189,8 @@ std::vector<StampedPose> readTrajectory(const std::string& path) {
     if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) {
       throw ParseError(path, line,
                        "a unit quaternion \"qx qy qz qw\" (|norm - 1| <= " +
-                           toString(kQuaternionNormTolerance) + ")",
-                       "norm " + toString(norm));
+                           formatNumber(kQuaternionNormTolerance) + ")",
+                       "norm " + formatNumber(norm));
     }
     poses.push_back({v[0], Pose3(q, Eigen::Vector3d(v[1], v[2], v[3]))});
   });

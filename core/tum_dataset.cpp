@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
 
 #include "core/errors.h"
+#include "core/image_sequence.h"
 #include "core/timestamp_association.h"
 
 namespace curvesfm {
@@ -64,32 +64,28 @@ std::vector<DatasetFrame> matchFrames(const std::vector<ImageEntry>& images,
   return frames;
 }
 
-// A missing file or one whose header names no format OpenCV reads fails here, before any
-// work, with readColorImage()'s message; decoding waits for the run.
-void checkImageFile(const std::string& path) {
-  if (!fs::exists(path) || !cv::haveImageReader(path)) readColorImage(path);
-}
-
-// Reads every file but the images, so that a bad one fails before any work; images are
-// checked here and decoded one at a time during the run.
 }  // namespace
 
+// The TUM reader of loadImageSequence() reads camera.yaml, rgb.txt and groundtruth.txt and checks
+// every image, so that bad input fails before any work; the initial poses are this function's.
 TumDataset loadTumDataset(const std::string& dir, const std::string& init_poses_flag,
                           double max_dt) {
   TumDataset d;
   d.camera_path = joinPath(dir, "camera.yaml");
   d.rgb_path = joinPath(dir, "rgb.txt");
-  d.camera.emplace(readCameraYaml(d.camera_path));
-  const std::vector<ImageEntry> images = readImageList(d.rgb_path);
+  ImageSequenceOptions options;
+  options.layout = DatasetLayout::kTum;
+  const ImageSequence sequence = loadImageSequence(dir, options);
+  d.camera.emplace(sequence.camera);
+  std::vector<ImageEntry> images;
+  for (const SequenceImage& image : sequence.images) {
+    images.push_back({image.timestamp, image.image_path});
+  }
   d.images = static_cast<int>(images.size());
   d.init_poses_path = initPosesPath(dir, init_poses_flag);
   d.frames = matchFrames(images, readTrajectory(d.init_poses_path), max_dt, d);
-  const std::string ground_truth = joinPath(dir, "groundtruth.txt");
-  if (fs::exists(ground_truth)) {
-    d.ground_truth_path = ground_truth;
-    d.ground_truth = readTrajectory(ground_truth);
-  }
-  for (const DatasetFrame& frame : d.frames) checkImageFile(frame.image_path);
+  d.ground_truth_path = sequence.ground_truth_source;
+  d.ground_truth = sequence.ground_truth;
   return d;
 }
 

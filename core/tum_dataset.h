@@ -30,7 +30,8 @@ struct TumDataset {
   std::vector<StampedPose> ground_truth;  ///< Empty without groundtruth.txt.
 };
 
-/// Reads the dataset in `dir`. The initial poses come from `init_poses_path`, or
+/// Reads the dataset in `dir` with loadImageSequence()'s TUM reader (camera.yaml is required
+/// here: IoError naming it when missing). The initial poses come from `init_poses_path`, or
 /// DIR/init_poses.txt when it is empty; each image takes the pose nearest in time within
 /// `max_dt` seconds (associateByTimestamp), images without one are left out. Every file but the
 /// images is parsed here and every image file checked to exist and have a format OpenCV reads,

@@ -2,7 +2,6 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -10,6 +9,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "test/support/temp_folder.h"
 
 namespace curvesfm {
 namespace {
@@ -19,21 +19,8 @@ using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
-class ColmapModelTest : public ::testing::Test {
+class ColmapModelTest : public testing::TempFolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(::testing::TempDir()) /
-           ("colmap_model_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  void write(const std::string& name, const std::string& text) const {
-    std::ofstream(path(name)) << text;
-  }
   // A rotation of 90 degrees about z (w = x = 0, z = y = sqrt(1/2)) and a translation.
   void writeText(const std::string& cameras) const {
     write("cameras.txt", "# Camera list\n" + cameras);
@@ -44,8 +31,6 @@ class ColmapModelTest : public ::testing::Test {
           "2 1 0 0 0 0 0 0 1 b.png\n"
           "\n");
   }
-
-  fs::path dir_;
 };
 
 TEST_F(ColmapModelTest, TextModelGivesCameraAndWorldToCameraPoses) {

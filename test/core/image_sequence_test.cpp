@@ -2,7 +2,6 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <filesystem>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "test/support/temp_folder.h"
 
 namespace curvesfm {
 namespace {
@@ -24,22 +24,8 @@ using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
 
 // Each test writes a tiny dataset (8 x 6 px images) into its own temporary folder.
-class ImageSequenceTest : public ::testing::Test {
+class ImageSequenceTest : public testing::TempFolderTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(::testing::TempDir()) /
-           ("image_sequence_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  void write(const std::string& name, const std::string& text) const {
-    fs::create_directories(fs::path(path(name)).parent_path());
-    std::ofstream(path(name)) << text;
-  }
   void image(const std::string& name, int width = 8, int height = 6) const {
     fs::create_directories(fs::path(path(name)).parent_path());
     writeImage(path(name), cv::Mat(height, width, CV_8UC3, cv::Scalar(90, 90, 90)));
@@ -51,8 +37,6 @@ class ImageSequenceTest : public ::testing::Test {
     options.camera = camera;
     return loadImageSequence(dir_.string(), options);
   }
-
-  fs::path dir_;
 };
 
 // A camera at centre c looking along +z after rotating by `angle` about y.

@@ -8,6 +8,7 @@
 #include "apps/cli/report_json.h"
 #include "apps/curve_ba_command.h"
 #include "apps/eval_command.h"
+#include "apps/init_command.h"
 #include "apps/point_ba_command.h"
 #include "apps/report_command.h"
 #include "apps/run_command.h"
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
   curvesfm::CurveBaCommand curve_ba(&app);
   curvesfm::EvalCommand eval(&app);
   curvesfm::SynthCommand synth(&app);
+  curvesfm::InitCommand init(&app);
   curvesfm::RunCommand run(&app);
   curvesfm::ReportCommand report(&app);
 
@@ -40,6 +42,7 @@ int main(int argc, char** argv) {
     if (curve_ba.selected()) curve_ba.validate();
     if (eval.selected()) eval.validate();
     if (synth.selected()) synth.validate();
+    if (init.selected()) init.validate();
     if (run.selected()) run.validate();
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
@@ -54,6 +57,7 @@ int main(int argc, char** argv) {
     if (curve_ba.selected()) return curve_ba.run();
     if (eval.selected()) return eval.run();
     if (synth.selected()) return synth.run();
+    if (init.selected()) return init.run();
     if (run.selected()) return run.run();
     if (report.selected()) return report.run();
   } catch (const curvesfm::Error& e) {

@@ -93,3 +93,21 @@ void writeCurvesObj(const std::string& path, const std::vector<PolyBezier>& curv
 }
 
 }  // namespace curvesfm
+
+namespace curvesfm {
+
+void writePointsPly(const std::string& path, const std::vector<ExportedPoint>& points) {
+  writeExport(path, [&](std::ostream& out) {
+    out << "ply\nformat ascii 1.0\ncomment curvesfm: the point-based initialiser's map\n"
+        << "element vertex " << points.size()
+        << "\nproperty double x\nproperty double y\nproperty double z\n"
+        << "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+        << "property int track_length\nend_header\n";
+    for (const ExportedPoint& p : points) {
+      out << p.position.x() << ' ' << p.position.y() << ' ' << p.position.z() << ' ' << int(p.red)
+          << ' ' << int(p.green) << ' ' << int(p.blue) << ' ' << p.track_length << '\n';
+    }
+  });
+}
+
+}  // namespace curvesfm

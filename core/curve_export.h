@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,5 +24,21 @@ void writeCurvesPly(const std::string& path, const std::vector<PolyBezier>& curv
 /// through its vertices (1-based indices, as OBJ counts them), preceded by `o curve_<k>`.
 void writeCurvesObj(const std::string& path, const std::vector<PolyBezier>& curves,
                     int samples_per_segment);
+
+}  // namespace curvesfm
+
+namespace curvesfm {
+
+/// One point of a sparse map for writePointsPly.
+struct ExportedPoint {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  std::uint8_t red = 0, green = 0, blue = 0;
+  int track_length = 0;  ///< Images that observe it.
+};
+
+/// Writes an ASCII PLY point cloud, the point-based initialiser's map beside the curves: per
+/// vertex x y z (double), red green blue (uchar) and track_length (int; MeshLab and CloudCompare
+/// show it as a scalar field). IoError naming the file if it cannot be written.
+void writePointsPly(const std::string& path, const std::vector<ExportedPoint>& points);
 
 }  // namespace curvesfm

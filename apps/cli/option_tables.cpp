@@ -558,3 +558,104 @@ void addTrajectoryEvaluationOptions(OptionsTable* table, TrajectoryEvaluationOpt
 }
 
 }  // namespace curvesfm
+
+namespace curvesfm {
+
+void addAbsolutePoseOptions(OptionsTable* table, AbsolutePoseOptions* o, const OptionPlace& place) {
+  table->group(o, "AbsolutePoseOptions", place.path, place.prefix, place.heading)
+      .number("max_reprojection_error_px", "max-reprojection-error", &o->max_reprojection_error_px,
+              "RANSAC inlier threshold on the reprojection error (px)")
+      .number("confidence", "confidence", &o->confidence, "RANSAC confidence")
+      .number("max_iterations", "max-iterations", &o->max_iterations, "Most RANSAC iterations")
+      .number("min_inliers", "min-inliers", &o->min_inliers, "Fewest inliers to register a frame")
+      .number("min_inlier_ratio", "min-inlier-ratio", &o->min_inlier_ratio,
+              "Fewest inliers as a fraction of the 2D-3D correspondences");
+}
+
+void addFeatureTrackOptions(OptionsTable* table, FeatureTrackOptions* o, const OptionPlace& place) {
+  table->group(o, "FeatureTrackOptions", place.path, place.prefix, place.heading)
+      .number("match_interval", "match-interval", &o->match_interval,
+              "Every this many frames descriptors are matched (1: every frame)")
+      .number("match_overlap", "match-overlap", &o->match_overlap,
+              "Earlier matching frames each matching frame is matched with (0: KLT only)")
+      .number("min_tracked_fraction", "min-tracked-fraction", &o->min_tracked_fraction,
+              "Below this fraction of KLT tracks kept, a frame and its predecessor are matched")
+      .number("merge_radius_px", "merge-radius", &o->merge_radius_px,
+              "A keypoint joins the KLT track this close in its frame (px)")
+      .number("verify_threshold_px", "verify-threshold", &o->verify_threshold_px,
+              "Descriptor matches must fit a RANSAC F or H this closely (px)")
+      .number("min_verified_matches", "min-verified-matches", &o->min_verified_matches,
+              "A pair with fewer verified matches keeps none");
+}
+
+void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* o,
+                                const std::string& path) {
+  const std::string heading = "Point initialiser";
+  table->group(o, "PointInitialiserOptions", path, "points-", heading)
+      .nested("undistort")
+      .nested("klt")
+      .nested("features")
+      .nested("tracks")
+      .nested("two_view")
+      .nested("registration")
+      .nested("ba")
+      .nested("local_ba")
+      .nested("global_ba")
+      .number("pair_search_frames", "pair-search-frames", &o->pair_search_frames,
+              "The initial pair's first frame is searched among this many frames")
+      .number("max_pair_gap", "max-pair-gap", &o->max_pair_gap,
+              "Most frames between the initial pair's two frames")
+      .number("min_pair_flow_px", "min-pair-flow", &o->min_pair_flow_px,
+              "Pairs whose shared tracks move less (median, px) are not tried")
+      .number("pair_flow_step", "pair-flow-step", &o->pair_flow_step,
+              "A second frame is tried when its median flow exceeds the last tried one's by this")
+      .number("min_pair_median_parallax_deg", "min-pair-parallax", &o->min_pair_median_parallax_deg,
+              "Smallest median triangulation angle of the initial pair (deg)")
+      .number("pair_parallax_cap_deg", "pair-parallax-cap", &o->pair_parallax_cap_deg,
+              "The pair score counts the median angle up to this (deg)")
+      .number("max_reprojection_error_px", "max-reprojection-error", &o->max_reprojection_error_px,
+              "Largest reprojection error of an observation kept in the map (px)")
+      .number("min_triangulation_angle_deg", "min-triangulation-angle",
+              &o->min_triangulation_angle_deg, "Smallest ray angle of a triangulated point (deg)")
+      .number("local_ba_frames", "local-ba-frames", &o->local_ba_frames,
+              "Frames refined by local BA: the new one and those registered just before")
+      .number("global_ba_growth", "global-ba-growth", &o->global_ba_growth,
+              "Global BA when the registered frames grew by this factor")
+      .number("max_registration_trials", "max-registration-trials", &o->max_registration_trials,
+              "Candidates tried per registration step before a model is stuck")
+      .number("max_models", "max-models", &o->max_models,
+              "Most sub-models started after registration failures")
+      .number("min_merge_points", "min-merge-points", &o->min_merge_points,
+              "Fewest shared points to merge two sub-models by Sim(3)");
+  table
+      ->group(&o->undistort, "ImageUndistorterOptions", path + "/undistort", "points-undistort-",
+              heading)
+      .number("valid_margin_px", "valid-margin", &o->undistort.valid_margin_px,
+              "Band along the border of the undistorted data (px)");
+  addPointTrackerOptions(table, &o->klt, {path + "/klt", "points-klt-", heading, ""});
+  addFeatureMatchingOptions(table, &o->features,
+                            {path + "/features", "points-features-", heading, ""});
+  addFeatureTrackOptions(table, &o->tracks, {path + "/tracks", "points-tracks-", heading, ""});
+  addTwoViewOptions(table, &o->two_view, {path + "/two_view", "points-two-view-", heading, ""});
+  addAbsolutePoseOptions(table, &o->registration,
+                         {path + "/registration", "points-pnp-", heading, ""});
+  addPointBundleAdjustmentOptions(table, &o->ba, {path + "/ba", "points-ba-", heading, ""});
+  addOptimizerOptions(table, &o->local_ba,
+                      {path + "/local_ba", "points-local-ba-", heading, "point local BA"});
+  addOptimizerOptions(table, &o->global_ba,
+                      {path + "/global_ba", "points-global-ba-", heading, "point global BA"});
+}
+
+void addImageSequenceOptions(OptionsTable* table, ImageSequenceOptions* o) {
+  table->group(o, "ImageSequenceOptions", "/sequence", "", "Dataset")
+      .enumeration("layout", "layout", &o->layout,
+                   "The dataset folder's layout (README \"Dataset layouts\"); auto detects it")
+      .text(
+          "camera", "camera", "FX,FY,CX,CY[,K1,K2,P1,P2[,K3]]", [o] { return o->camera; },
+          [o](const std::string& text) { o->camera = text; },
+          "Intrinsics (px) instead of the dataset's own")
+      .number("max_frames", "max-frames", &o->max_frames, "At most this many images (0: all)")
+      .number("stride", "stride", &o->stride, "Every stride-th image");
+}
+
+}  // namespace curvesfm

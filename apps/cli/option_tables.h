@@ -4,6 +4,7 @@
 
 #include "apps/cli/options_table.h"
 #include "core/camera.h"
+#include "core/image_sequence.h"
 #include "core/trajectory_evaluation.h"
 #include "factors/curve_bundle_adjustment.h"
 #include "factors/point_bundle_adjustment.h"
@@ -12,6 +13,7 @@
 #include "frontend/image/point_tracks.h"
 #include "frontend/image/two_view_geometry.h"
 #include "frontend/mapping/pipeline.h"
+#include "frontend/mapping/point_initialiser.h"
 #include "graph/optimizer.h"
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
@@ -51,6 +53,18 @@ void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentO
 void addPipelineOptions(OptionsTable* table, PipelineOptions* options, const std::string& path);
 void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* options,
                             const OptionPlace& place);
+/// The point-based initialiser (init, and run without initial poses): every flag starts with
+/// "points-" (e.g. --points-klt-grid-cols, --points-pnp-min-inliers) so that it never meets the
+/// curve pipeline's flags in `run`.
+void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* options,
+                                const std::string& path);
+/// The dataset flags `init` and `run` share: the layout, the camera override and which images to
+/// take (report.json "options/sequence").
+void addImageSequenceOptions(OptionsTable* table, ImageSequenceOptions* options);
+void addFeatureTrackOptions(OptionsTable* table, FeatureTrackOptions* options,
+                            const OptionPlace& place);
+void addAbsolutePoseOptions(OptionsTable* table, AbsolutePoseOptions* options,
+                            const OptionPlace& place);
 void addPointTrackerOptions(OptionsTable* table, PointTrackerOptions* options,
                             const OptionPlace& place);
 void addFeatureMatchingOptions(OptionsTable* table, FeatureMatchingOptions* options,
@@ -64,7 +78,6 @@ void addPointSceneOptions(OptionsTable* table, PointSceneOptions* options,
 /// cx and cy are not flags: `curvesfm synth planar` centres the principal point.
 void addPlanarSceneOptions(OptionsTable* table, PlanarSceneOptions* options,
                            const OptionPlace& place);
-/// Not wired into a command yet: the initialiser (issue 13) will take it.
 void addTwoViewOptions(OptionsTable* table, TwoViewOptions* options, const OptionPlace& place);
 void addTrajectoryEvaluationOptions(OptionsTable* table, TrajectoryEvaluationOptions* options,
                                     const OptionPlace& place);

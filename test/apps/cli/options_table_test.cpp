@@ -23,8 +23,8 @@ using ::testing::HasSubstr;
 struct AllOptions {
   PipelineOptions pipeline;
   CurveOverlayOptions overlay;
-  PointTrackerOptions point_tracker;
-  FeatureMatchingOptions feature_matching;
+  PointInitialiserOptions points;
+  ImageSequenceOptions sequence;
   CurveSceneOptions curve_scene;
   CurveBundleAdjustmentOptions curve_ba;
   SchedulerOptions scheduler;
@@ -33,21 +33,16 @@ struct AllOptions {
   OptimizerOptions optimizer;
   PlanarSceneOptions planar;
   TrajectoryEvaluationOptions evaluation;
-  TwoViewOptions two_view;
 };
 
-// The tables as the commands build them (run, curve-ba, point-ba, synth planar, eval), with the
-// two-view options in run's table ahead of the initialiser that will use them.
+// The tables as the commands build them (run, curve-ba, point-ba, synth planar, eval); init's
+// table is run's point initialiser part.
 std::vector<OptionsTable> commandTables(AllOptions* o) {
   std::vector<OptionsTable> tables(5);
   addPipelineOptions(&tables[0], &o->pipeline, "/pipeline");
   addCurveOverlayOptions(&tables[0], &o->overlay, {"/overlay", "overlay-", "Overlays", ""});
-  // Not yet wired into a command: the initialiser (issue 13) will put them in `run` and `init`.
-  addTwoViewOptions(&tables[0], &o->two_view, {"/two_view", "two-view-", "Two-view geometry", ""});
-  addPointTrackerOptions(&tables[0], &o->point_tracker,
-                         {"/point_tracker", "points-", "Point tracks", ""});
-  addFeatureMatchingOptions(&tables[0], &o->feature_matching,
-                            {"/feature_matching", "match-features-", "Feature matching", ""});
+  addPointInitialiserOptions(&tables[0], &o->points, "/points");
+  addImageSequenceOptions(&tables[0], &o->sequence);
   addCurveSceneOptions(&tables[1], &o->curve_scene, {"/scene", "", "Scene", ""});
   addCurveBundleAdjustmentOptions(&tables[1], &o->curve_ba, {"/ba", "", "Objective", ""});
   addSchedulerOptions(&tables[1], &o->scheduler, {"/scheduler", "", "Schedule", ""},

@@ -1,0 +1,221 @@
+#include "apps/cli/initialisation_output.h"
+
+#include <cstdio>
+#include <map>
+
+#include "apps/cli/report_json.h"
+#include "core/clock.h"
+#include "core/curve_export.h"
+#include "core/errors.h"
+#include "core/trajectory_evaluation.h"
+
+namespace curvesfm {
+namespace {
+
+// "3-7, 12, 20-21": frame indices as ranges, for the lines that list unregistered frames.
+std::string frameRanges(const std::vector<int>& frames) {
+  std::string text;
+  for (std::size_t i = 0; i < frames.size();) {
+    std::size_t j = i;
+    while (j + 1 < frames.size() && frames[j + 1] == frames[j] + 1) ++j;
+    if (!text.empty()) text += ", ";
+    text += std::to_string(frames[i]);
+    if (j > i) text += "-" + std::to_string(frames[j]);
+    i = j + 1;
+  }
+  return text;
+}
+
+nlohmann::json optimizationToJson(const InitialiserBundleAdjustment& ba) {
+  const OptimizationSummary& s = ba.summary;
+  return {{"scope", ba.scope},
+          {"model", ba.model},
+          {"frames", ba.frames},
+          {"points", ba.points},
+          {"observations", ba.observations},
+          {"initial_cost", s.initial_cost},
+          {"final_cost", s.final_cost},
+          {"iterations", s.iterations},
+          {"termination", s.termination},
+          {"seconds", s.total_seconds}};
+}
+
+// Sums of the BAs of one scope: the report lists every solve, the summary line these.
+struct BaTotals {
+  int solves = 0, iterations = 0;
+  double seconds = 0.0;
+};
+
+std::map<std::string, BaTotals> baTotals(const PointInitialisation& result) {
+  std::map<std::string, BaTotals> totals;
+  for (const InitialiserBundleAdjustment& ba : result.bundle_adjustments) {
+    BaTotals& t = totals[ba.scope];
+    ++t.solves;
+    t.iterations += ba.summary.iterations;
+    t.seconds += ba.summary.total_seconds;
+  }
+  return totals;
+}
+
+}  // namespace
+
+PointInitialisation initialiseSequence(const ImageSequence& sequence,
+                                       const PointInitialiserOptions& options) {
+  PointInitialiser initialiser(sequence.camera, options);
+  const int frames = static_cast<int>(sequence.images.size());
+  const int every = std::max(1, frames / 10);
+  const Clock::time_point start = Clock::now();
+  for (int i = 0; i < frames; ++i) {
+    const cv::Mat image = readColorImage(sequence.images[i].image_path);
+    if (image.cols != sequence.camera.width() || image.rows != sequence.camera.height()) {
+      throw IoError(sequence.images[i].image_path,
+                    "is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                        " but the camera (" + sequence.camera_source + ") is " +
+                        std::to_string(sequence.camera.width()) + "x" +
+                        std::to_string(sequence.camera.height()));
+    }
+    initialiser.addFrame(image);
+    if ((i + 1) % every == 0 || i + 1 == frames) {
+      std::printf("init: tracked %d/%d frames (%.1f s)\n", i + 1, frames, secondsSince(start));
+      std::fflush(stdout);
+    }
+  }
+  initialiser.setProgress([every, start](int model, int registered, int total, int points) {
+    if (registered % every != 0 && registered != total) return;
+    std::printf("init: model %d registered %d/%d frames, %d points (%.1f s)\n", model, registered,
+                total, points, secondsSince(start));
+    std::fflush(stdout);
+  });
+  return initialiser.finish();
+}
+
+std::vector<StampedPose> initialisedTrajectory(const ImageSequence& sequence,
+                                               const PointInitialisation& result) {
+  std::vector<double> timestamps;
+  std::vector<Pose3> poses;
+  for (std::size_t i = 0; i < result.frames.size(); ++i) {
+    if (!result.frames[i].cam_from_world) continue;
+    timestamps.push_back(sequence.images[i].timestamp);
+    poses.push_back(*result.frames[i].cam_from_world);
+  }
+  return stampedPoses(timestamps, poses);
+}
+
+void writeInitialisedPoints(const std::string& path, const PointInitialisation& result) {
+  std::vector<ExportedPoint> points;
+  points.reserve(result.points.size());
+  for (const InitialisedPoint& p : result.points) {
+    points.push_back({p.position, p.colour_bgr[2], p.colour_bgr[1], p.colour_bgr[0],
+                      static_cast<int>(p.observations.size())});
+  }
+  writePointsPly(path, points);
+}
+
+nlohmann::json initialisationToJson(const ImageSequence& sequence,
+                                    const PointInitialisation& result) {
+  nlohmann::json frames = nlohmann::json::array();
+  for (std::size_t i = 0; i < result.frames.size(); ++i) {
+    const InitialisedFrame& f = result.frames[i];
+    nlohmann::json frame = {{"index", i},
+                            {"image", sequence.images[i].name},
+                            {"timestamp", sequence.images[i].timestamp},
+                            {"status", toString(f.status)},
+                            {"model", f.model},
+                            {"correspondences", f.correspondences},
+                            {"inliers", f.inliers},
+                            {"klt_tracked", result.track_stats[i].klt_tracked},
+                            {"matching_frame", result.track_stats[i].matching_frame},
+                            {"descriptor_matches", result.track_stats[i].matches}};
+    if (f.status == FrameRegistration::kRejected) frame["rejection"] = toString(f.rejection);
+    frames.push_back(frame);
+  }
+  nlohmann::json bas = nlohmann::json::array();
+  for (const InitialiserBundleAdjustment& ba : result.bundle_adjustments) {
+    bas.push_back(optimizationToJson(ba));
+  }
+  const InitialiserTimes& t = result.seconds;
+  const TwoViewGeometry& g = result.initial_geometry;
+  return {{"counts",
+           {{"frames", result.frames.size()},
+            {"registered", result.registeredFrames()},
+            {"tracks", result.num_tracks},
+            {"points", result.points.size()},
+            {"models", result.models},
+            {"merged_models", result.merged_models},
+            {"pairs_tried", result.pairs_tried}}},
+          {"scale_convention", result.scale_convention},
+          {"initial_pair",
+           {{"frames", {result.initial_pair.first, result.initial_pair.second}},
+            {"model", toString(g.model)},
+            {"inliers", g.num_inliers},
+            {"points", g.points_in_cam_a.size()},
+            {"median_parallax_deg", g.median_parallax_deg}}},
+          {"failure", result.failure},
+          {"frames", frames},
+          {"bundle_adjustments", bas},
+          {"seconds",
+           {{"undistort", t.undistort},
+            {"klt", t.klt},
+            {"matching", t.matching},
+            {"pair_search", t.pair_search},
+            {"registration", t.registration},
+            {"triangulation", t.triangulation},
+            {"local_ba", t.local_ba},
+            {"global_ba", t.global_ba},
+            {"merge", t.merge},
+            {"total", t.total}}}};
+}
+
+nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
+                                          const PointInitialisation& result) {
+  const int frames = static_cast<int>(result.frames.size());
+  std::printf(
+      "init: %d of %d frames registered (%d models, %d merged), %zu points from %d tracks\n",
+      result.registeredFrames(), frames, result.models, result.merged_models, result.points.size(),
+      result.num_tracks);
+  std::map<std::string, std::vector<int>> unregistered;
+  for (int i = 0; i < frames; ++i) {
+    const InitialisedFrame& f = result.frames[i];
+    if (f.status == FrameRegistration::kRegistered) continue;
+    std::string reason = toString(f.status);
+    if (f.status == FrameRegistration::kRejected) reason += " (" + toString(f.rejection) + ")";
+    unregistered[reason].push_back(i);
+  }
+  for (const auto& [reason, list] : unregistered) {
+    std::printf("init: not registered, %s: frames %s\n", reason.c_str(), frameRanges(list).c_str());
+  }
+  const InitialiserTimes& t = result.seconds;
+  std::printf(
+      "init time: tracks %.2f s (KLT %.2f, descriptors %.2f; %.1f ms per frame), pair search "
+      "%.2f s, registration %.2f s, triangulation %.2f s, local BA %.2f s, global BA %.2f s, "
+      "total %.2f s\n",
+      t.klt + t.matching + t.undistort, t.klt, t.matching,
+      frames > 0 ? 1e3 * (t.klt + t.matching + t.undistort) / frames : 0.0, t.pair_search,
+      t.registration, t.triangulation, t.local_ba, t.global_ba, t.total);
+  for (const auto& [scope, totals] : baTotals(result)) {
+    std::printf("init BA %s: %d solves, %d iterations, %.2f s\n", scope.c_str(), totals.solves,
+                totals.iterations, totals.seconds);
+  }
+  if (sequence.ground_truth.empty() || result.registeredFrames() < 3) return nullptr;
+  try {
+    const TrajectoryEvaluation e = compareTrajectories(
+        initialisedTrajectory(sequence, result), sequence.ground_truth,
+        TrajectoryEvaluationOptions{}, "initialiser trajectory", sequence.ground_truth_source);
+    std::printf(
+        "init ATE (sim3) vs %s over %d frames: rmse %.6f, mean %.6f, median %.6f (ground "
+        "truth unit)\n",
+        sequence.ground_truth_source.c_str(), e.ate.count, e.ate.rmse, e.ate.mean, e.ate.median);
+    return {{"alignment", "sim3"},
+            {"matched", e.ate.count},
+            {"rmse", e.ate.rmse},
+            {"mean", e.ate.mean},
+            {"median", e.ate.median},
+            {"max", e.ate.max},
+            {"rpe_translation_rmse", e.rpe_translation_stats.rmse}};
+  } catch (const TrajectoryEvaluationError& e) {
+    std::printf("init ATE: not computed: %s\n", e.what());
+    return {{"problem", e.what()}};
+  }
+}
+
+}  // namespace curvesfm

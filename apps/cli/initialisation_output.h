@@ -1,0 +1,41 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "core/dataset_io.h"
+#include "core/image_sequence.h"
+#include "frontend/mapping/point_initialiser.h"
+
+namespace curvesfm {
+
+// What `init` and `run` (without initial poses) share: running the point initialiser over a
+// sequence with progress lines, its summary, and its files (trajectory, points, report part).
+
+/// Runs the initialiser over every image of `sequence`, printing a line every tenth of the
+/// frames while tracking and after every tenth registered frame. IoError for an image that does
+/// not load or has another size than the camera.
+PointInitialisation initialiseSequence(const ImageSequence& sequence,
+                                       const PointInitialiserOptions& options);
+
+/// The registered frames as a TUM trajectory (camera-to-world, the images' timestamps).
+std::vector<StampedPose> initialisedTrajectory(const ImageSequence& sequence,
+                                               const PointInitialisation& result);
+
+/// Writes the map as points.ply (colour and track length per point) at `path`.
+void writeInitialisedPoints(const std::string& path, const PointInitialisation& result);
+
+/// The report.json part of the initialiser: counts, the scale convention, the initial pair, per
+/// frame its registration (status, reason, correspondences, inliers), every BA's summary and the
+/// per-stage times.
+nlohmann::json initialisationToJson(const ImageSequence& sequence,
+                                    const PointInitialisation& result);
+
+/// Prints the summary: frames registered, the unregistered frames by reason, models, points,
+/// times; with ground truth, the Sim(3) ATE of the registered frames. Returns that ATE's JSON
+/// (null without ground truth).
+nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
+                                          const PointInitialisation& result);
+
+}  // namespace curvesfm

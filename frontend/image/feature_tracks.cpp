@@ -1,0 +1,282 @@
+#include "frontend/image/feature_tracks.h"
+
+#include <algorithm>
+#include <numeric>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/check.h"
+#include "core/clock.h"
+#include "core/errors.h"
+
+namespace curvesfm {
+
+void FeatureTrackOptions::validate() const {
+  const OptionCheck require("FeatureTrackOptions");
+  require(match_interval >= 1 && match_interval <= 1000, "match_interval", match_interval,
+          "in [1, 1000]");
+  require(match_overlap >= 0 && match_overlap <= 20, "match_overlap", match_overlap, "in [0, 20]");
+  require(min_tracked_fraction >= 0.0 && min_tracked_fraction <= 1.0, "min_tracked_fraction",
+          min_tracked_fraction, "in [0, 1]");
+  require.nonNegative("merge_radius_px", merge_radius_px);
+  require.positive("verify_threshold_px", verify_threshold_px);
+  require(min_verified_matches >= 8, "min_verified_matches", min_verified_matches, ">= 8");
+}
+
+const Eigen::Vector2d* FeatureTracks::pixel(int track, int frame) const {
+  const std::vector<TrackObservation>& obs = tracks[track].observations;
+  const auto it = std::lower_bound(obs.begin(), obs.end(), frame,
+                                   [](const TrackObservation& o, int f) { return o.frame < f; });
+  return it != obs.end() && it->frame == frame ? &it->pixel : nullptr;
+}
+
+std::vector<int> FeatureTracks::sharedTracks(int frame_a, int frame_b) const {
+  std::vector<int> shared;
+  std::set_intersection(frame_tracks[frame_a].begin(), frame_tracks[frame_a].end(),
+                        frame_tracks[frame_b].begin(), frame_tracks[frame_b].end(),
+                        std::back_inserter(shared));
+  return shared;
+}
+
+namespace {
+
+// Disjoint sets with path halving; the root of a set is its smallest node, so that the order of
+// the tracks does not depend on the order of the unions.
+class UnionFind {
+ public:
+  explicit UnionFind(int n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  int find(int x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  void join(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+ private:
+  std::vector<int> parent_;
+};
+
+// A node of the correspondence graph before the KLT ids are all known: a KLT track id (>= 0) or
+// keypoint k as -(k + 1).
+using NodeRef = int;
+NodeRef keypointRef(int k) { return -(k + 1); }
+
+cv::Vec3b colourAt(const cv::Mat& image, const Eigen::Vector2d& pixel) {
+  const int x = std::clamp(static_cast<int>(std::lround(pixel.x())), 0, image.cols - 1);
+  const int y = std::clamp(static_cast<int>(std::lround(pixel.y())), 0, image.rows - 1);
+  if (image.type() == CV_8UC1) {
+    const uchar v = image.at<uchar>(y, x);
+    return cv::Vec3b(v, v, v);
+  }
+  return image.at<cv::Vec3b>(y, x);
+}
+
+// The matches a fundamental matrix or a homography explains (RANSAC, whichever keeps more), as
+// COLMAP verifies every image pair before it builds tracks: one wrong match joins two scene
+// points into one track. Fewer than `min_matches` survivors: none is kept.
+std::vector<FeatureMatch> verifiedMatches(const std::vector<FeatureMatch>& matches,
+                                          double threshold_px, int min_matches) {
+  if (static_cast<int>(matches.size()) < min_matches) return {};
+  std::vector<cv::Point2f> a, b;
+  for (const FeatureMatch& m : matches) {
+    a.emplace_back(static_cast<float>(m.pixel_a.x()), static_cast<float>(m.pixel_a.y()));
+    b.emplace_back(static_cast<float>(m.pixel_b.x()), static_cast<float>(m.pixel_b.y()));
+  }
+  cv::theRNG().state = 0x2545F491;  // RANSAC draws from OpenCV's global generator.
+  std::vector<uchar> f_mask, h_mask;
+  cv::findFundamentalMat(a, b, cv::FM_RANSAC, threshold_px, 0.999, f_mask);
+  cv::findHomography(a, b, cv::RANSAC, threshold_px, h_mask, 2000, 0.999);
+  const auto count = [](const std::vector<uchar>& mask) {
+    return static_cast<int>(std::count(mask.begin(), mask.end(), 1));
+  };
+  const std::vector<uchar>& mask = count(h_mask) > count(f_mask) ? h_mask : f_mask;
+  if (count(mask) < min_matches) return {};
+  std::vector<FeatureMatch> kept;
+  for (std::size_t i = 0; i < matches.size(); ++i) {
+    if (mask[i]) kept.push_back(matches[i]);
+  }
+  return kept;
+}
+
+struct Keypoint {
+  int frame = -1;
+  Eigen::Vector2d pixel;
+  cv::Vec3b colour;
+};
+
+struct MatchingFrame {
+  int frame = -1;
+  FeatureSet features;
+  int first_keypoint = 0;  // Index of its keypoint 0 among all keypoints.
+};
+
+}  // namespace
+
+struct FeatureTrackBuilder::State {
+  FeatureTrackOptions options;
+  FeatureMatchingOptions matching;
+  PointTracker tracker;
+  PointTracks klt;
+  std::vector<std::vector<TrackedPoint>> klt_frames;  // Live KLT points of every frame.
+  std::vector<cv::Vec3b> klt_colours;                 // By KLT track id.
+  std::vector<Keypoint> keypoints;
+  std::vector<std::pair<NodeRef, NodeRef>> links;
+  std::deque<MatchingFrame> window;  // The last match_overlap matching frames.
+  std::vector<FeatureTrackFrameStats> stats;
+  cv::Mat previous_image;
+  int last_matching_frame = -1;
+
+  State(const FeatureTrackOptions& o, const PointTrackerOptions& t, const FeatureMatchingOptions& m)
+      : options(o), matching(m), tracker(t) {
+    options.validate();
+    matching.validate();
+  }
+
+  int numFrames() const { return static_cast<int>(klt_frames.size()); }
+
+  void trackKlt(const cv::Mat& image) {
+    const Clock::time_point start = Clock::now();
+    const PointFrame frame = tracker.track(image);
+    klt.add(frame);
+    for (std::size_t i = static_cast<std::size_t>(frame.tracked); i < frame.points.size(); ++i) {
+      const TrackedPoint& p = frame.points[i];
+      if (p.track >= static_cast<int>(klt_colours.size())) klt_colours.resize(p.track + 1);
+      klt_colours[p.track] = colourAt(image, p.pixel);
+    }
+    klt_frames.push_back(frame.points);
+    FeatureTrackFrameStats s;
+    s.klt_tracked = frame.tracked;
+    s.klt_live = static_cast<int>(frame.points.size());
+    s.klt_seconds = secondsSince(start);
+    stats.push_back(s);
+  }
+
+  // The KLT track nearest to `pixel` in `frame` within merge_radius_px, or -1.
+  int nearestKltTrack(int frame, const Eigen::Vector2d& pixel) const {
+    int best = -1;
+    double best_distance = options.merge_radius_px;
+    for (const TrackedPoint& p : klt_frames[frame]) {
+      const double d = (p.pixel - pixel).norm();
+      if (d <= best_distance) {
+        best = p.track;
+        best_distance = d;
+      }
+    }
+    return best;
+  }
+
+  void makeMatchingFrame(int frame, const cv::Mat& image) {
+    const Clock::time_point start = Clock::now();
+    MatchingFrame m;
+    m.frame = frame;
+    m.features = detectFeatures(image, matching);
+    m.first_keypoint = static_cast<int>(keypoints.size());
+    for (int k = 0; k < m.features.size(); ++k) {
+      const Eigen::Vector2d& pixel = m.features.pixels[k];
+      keypoints.push_back({frame, pixel, colourAt(image, pixel)});
+      const int klt_track = nearestKltTrack(frame, pixel);
+      if (klt_track >= 0) links.emplace_back(klt_track, keypointRef(m.first_keypoint + k));
+    }
+    FeatureTrackFrameStats& s = stats[frame];
+    s.matching_frame = true;
+    s.features = m.features.size();
+    for (const MatchingFrame& earlier : window) {
+      const std::vector<FeatureMatch> matches =
+          verifiedMatches(matchFeatures(earlier.features, m.features, matching),
+                          options.verify_threshold_px, options.min_verified_matches);
+      for (const FeatureMatch& match : matches) {
+        links.emplace_back(keypointRef(earlier.first_keypoint + match.index_a),
+                           keypointRef(m.first_keypoint + match.index_b));
+        ++s.matches;
+      }
+    }
+    if (options.match_overlap > 0) {
+      window.push_back(std::move(m));
+      while (static_cast<int>(window.size()) > options.match_overlap) window.pop_front();
+    }
+    last_matching_frame = frame;
+    s.match_seconds += secondsSince(start);
+  }
+
+  void addFrame(const cv::Mat& image) {
+    const int frame = numFrames();
+    const int previous_live = frame > 0 ? stats.back().klt_live : 0;
+    trackKlt(image);
+    // A frame after one without any live track is broken too: nothing could be followed.
+    const bool broken =
+        frame > 0 && (previous_live == 0 ||
+                      stats.back().klt_tracked < options.min_tracked_fraction * previous_live);
+    if (broken && last_matching_frame < frame - 1) makeMatchingFrame(frame - 1, previous_image);
+    if (frame % options.match_interval == 0 || broken) makeMatchingFrame(frame, image);
+    previous_image = image.clone();
+  }
+
+  FeatureTracks finish() {
+    const int frames = numFrames();
+    if (frames > 0 && last_matching_frame < frames - 1) {
+      makeMatchingFrame(frames - 1, previous_image);
+    }
+    const int num_klt = static_cast<int>(klt_colours.size());
+    const int num_nodes = num_klt + static_cast<int>(keypoints.size());
+    const auto node = [num_klt](NodeRef ref) { return ref >= 0 ? ref : num_klt - ref - 1; };
+    UnionFind sets(num_nodes);
+    for (const auto& [a, b] : links) sets.join(node(a), node(b));
+
+    // Observations per set, in node order: KLT tracks' first, so they win a frame conflict.
+    std::vector<int> track_of_root(num_nodes, -1);
+    std::vector<FeatureTrack> joined;
+    const auto trackOf = [&](int n, const cv::Vec3b& colour) -> FeatureTrack& {
+      const int root = sets.find(n);
+      if (track_of_root[root] < 0) {
+        track_of_root[root] = static_cast<int>(joined.size());
+        joined.push_back({{}, colour});
+      }
+      return joined[track_of_root[root]];
+    };
+    for (const auto& [id, observations] : klt.tracks()) {
+      FeatureTrack& track = trackOf(id, klt_colours[id]);
+      track.observations.insert(track.observations.end(), observations.begin(), observations.end());
+    }
+    for (int k = 0; k < static_cast<int>(keypoints.size()); ++k) {
+      const Keypoint& kp = keypoints[k];
+      trackOf(num_klt + k, kp.colour).observations.push_back({kp.frame, kp.pixel});
+    }
+
+    FeatureTracks out;
+    out.num_frames = frames;
+    out.frame_tracks.resize(frames);
+    out.frames = stats;
+    for (FeatureTrack& track : joined) {
+      std::vector<TrackObservation>& obs = track.observations;
+      std::stable_sort(
+          obs.begin(), obs.end(),
+          [](const TrackObservation& a, const TrackObservation& b) { return a.frame < b.frame; });
+      obs.erase(std::unique(obs.begin(), obs.end(),
+                            [](const TrackObservation& a, const TrackObservation& b) {
+                              return a.frame == b.frame;
+                            }),
+                obs.end());
+      if (obs.size() < 2) continue;
+      const int index = static_cast<int>(out.tracks.size());
+      for (const TrackObservation& o : obs) out.frame_tracks[o.frame].push_back(index);
+      out.tracks.push_back(std::move(track));
+    }
+    return out;
+  }
+};
+
+FeatureTrackBuilder::FeatureTrackBuilder(const FeatureTrackOptions& options,
+                                         const PointTrackerOptions& tracker,
+                                         const FeatureMatchingOptions& matching)
+    : state_(std::make_unique<State>(options, tracker, matching)) {}
+
+FeatureTrackBuilder::~FeatureTrackBuilder() = default;
+
+void FeatureTrackBuilder::addFrame(const cv::Mat& image) { state_->addFrame(image); }
+
+FeatureTracks FeatureTrackBuilder::finish() { return state_->finish(); }
+
+}  // namespace curvesfm

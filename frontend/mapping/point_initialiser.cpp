@@ -1,0 +1,730 @@
+#include "frontend/mapping/point_initialiser.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <set>
+#include <sstream>
+
+#include "core/check.h"
+#include "core/clock.h"
+#include "core/errors.h"
+#include "core/point_triangulation.h"
+#include "core/similarity_alignment.h"
+#include "factors/pose_variables.h"
+#include "graph/key.h"
+
+namespace curvesfm {
+
+OptimizerOptions PointInitialiserOptions::defaultLocalSolver() {
+  OptimizerOptions o;
+  o.max_iterations = 10;
+  return o;
+}
+
+OptimizerOptions PointInitialiserOptions::defaultGlobalSolver() {
+  OptimizerOptions o;
+  o.max_iterations = 30;
+  return o;
+}
+
+void PointInitialiserOptions::validate() const {
+  undistort.validate();
+  klt.validate();
+  features.validate();
+  tracks.validate();
+  two_view.validate();
+  registration.validate();
+  ba.validate();
+  local_ba.validate();
+  global_ba.validate();
+  const OptionCheck require("PointInitialiserOptions");
+  require(pair_search_frames >= 1, "pair_search_frames", pair_search_frames, ">= 1");
+  require(max_pair_gap >= 1, "max_pair_gap", max_pair_gap, ">= 1");
+  require.nonNegative("min_pair_flow_px", min_pair_flow_px);
+  require(pair_flow_step >= 1.0 && pair_flow_step < 1e6, "pair_flow_step", pair_flow_step,
+          "finite and >= 1");
+  require(min_pair_median_parallax_deg >= 0.0 && min_pair_median_parallax_deg < 90.0,
+          "min_pair_median_parallax_deg", min_pair_median_parallax_deg, "in [0, 90)");
+  require(pair_parallax_cap_deg > 0.0 && pair_parallax_cap_deg <= 90.0, "pair_parallax_cap_deg",
+          pair_parallax_cap_deg, "in (0, 90]");
+  require.positive("max_reprojection_error_px", max_reprojection_error_px);
+  require(min_triangulation_angle_deg >= 0.0 && min_triangulation_angle_deg < 90.0,
+          "min_triangulation_angle_deg", min_triangulation_angle_deg, "in [0, 90)");
+  require(local_ba_frames >= 1, "local_ba_frames", local_ba_frames, ">= 1");
+  require(global_ba_growth > 1.0 && global_ba_growth < 1e6, "global_ba_growth", global_ba_growth,
+          "finite and > 1");
+  require(max_registration_trials >= 1, "max_registration_trials", max_registration_trials, ">= 1");
+  require(max_models >= 1, "max_models", max_models, ">= 1");
+  require(min_merge_points >= 3, "min_merge_points", min_merge_points, ">= 3");
+}
+
+int PointInitialisation::registeredFrames() const {
+  return static_cast<int>(std::count_if(frames.begin(), frames.end(), [](const auto& f) {
+    return f.status == FrameRegistration::kRegistered;
+  }));
+}
+
+namespace {
+
+// A point of a model: its position and the registered frames whose observation it uses. A
+// removed point keeps its slot (track -1) so that indices stay valid.
+struct MapPoint {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  int track = -1;
+  std::vector<int> frames;
+  bool alive() const { return track >= 0; }
+};
+
+// One sub-model of the reconstruction.
+struct Model {
+  std::pair<int, int> pair = {-1, -1};
+  std::vector<std::optional<Pose3>> poses;  // Per frame.
+  std::vector<int> registration_order;
+  std::vector<MapPoint> points;
+  std::vector<int> point_of_track;  // Per track: its point, or -1.
+  int registered_at_last_global_ba = 0;
+
+  Model(int frames, int tracks) : poses(frames), point_of_track(tracks, -1) {}
+  int registered() const { return static_cast<int>(registration_order.size()); }
+  void registerFrame(int frame, const Pose3& pose) {
+    poses[frame] = pose;
+    registration_order.push_back(frame);
+  }
+  int addPoint(const Eigen::Vector3d& position, int track, std::vector<int> frames) {
+    point_of_track[track] = static_cast<int>(points.size());
+    points.push_back({position, track, std::move(frames)});
+    return point_of_track[track];
+  }
+  void removePoint(int p) {
+    point_of_track[points[p].track] = -1;
+    points[p].track = -1;
+    points[p].frames.clear();
+  }
+};
+
+// The median of `values` (copied); 0 when empty.
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const auto mid = values.begin() + values.size() / 2;
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+Eigen::Vector3d centreOf(const Pose3& cam_from_world) {
+  return cam_from_world.inverseTranslation();
+}
+
+}  // namespace
+
+struct PointInitialiser::State {
+  PointInitialiserOptions options;
+  ImageUndistorter undistorter;
+  std::shared_ptr<const Camera> camera;  // The undistorted pinhole camera.
+  FeatureTrackBuilder builder;
+  FeatureTracks tracks;
+  PointInitialisation out;
+  int frames_added = 0;
+  PointInitialiser::Progress progress;
+  double add_frame_seconds = 0.0;  // Undistortion and tracks, frame by frame.
+
+  State(const Camera& source, const PointInitialiserOptions& o)
+      : options((o.validate(), o)),
+        undistorter(source, o.undistort),
+        camera(std::make_shared<Camera>(undistorter.camera())),
+        builder(o.tracks, o.klt, o.features) {}
+
+  int numFrames() const { return tracks.num_frames; }
+
+  // -------------------------------------------------------------------------------------------
+  // Geometry of one observation.
+
+  const Eigen::Vector2d& pixelOf(int track, int frame) const {
+    const Eigen::Vector2d* p = tracks.pixel(track, frame);
+    CURVESFM_CHECK(p != nullptr) << "track " << track << " is not seen in frame " << frame;
+    return *p;
+  }
+
+  // Whether `point` lies in front of the frame and reprojects within the map's bound.
+  bool reprojects(const Model& model, int frame, int track, const Eigen::Vector3d& point) const {
+    Eigen::Vector2d projected;
+    if (!camera->project(*model.poses[frame] * point, &projected)) return false;
+    return (projected - pixelOf(track, frame)).norm() <= options.max_reprojection_error_px;
+  }
+
+  // The widest ray angle among (at most 8 evenly spread) frames: the gate needs the baseline the
+  // track spans, and its ends give nearly all of it.
+  double angleDeg(const Model& model, const std::vector<int>& frames,
+                  const Eigen::Vector3d& point) const {
+    std::vector<Eigen::Vector3d> centres;
+    const std::size_t step = std::max<std::size_t>(1, frames.size() / 8);
+    for (std::size_t i = 0; i < frames.size(); i += step) {
+      centres.push_back(centreOf(*model.poses[frames[i]]));
+    }
+    centres.push_back(centreOf(*model.poses[frames.back()]));
+    return maxTriangulationAngleDeg(centres, point);
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Triangulation.
+
+  std::vector<int> registeredFramesOf(const Model& model, int track) const {
+    std::vector<int> frames;
+    for (const TrackObservation& o : tracks.tracks[track].observations) {
+      if (model.poses[o.frame]) frames.push_back(o.frame);
+    }
+    return frames;
+  }
+
+  // Triangulates `track` from its registered observations (see the header, step 4); `anchor` is
+  // the frame to pair with the farthest other one (the new frame), or -1 for the track's ends.
+  bool triangulateTrack(Model* model, int track, int anchor) const {
+    const std::vector<int> frames = registeredFramesOf(*model, track);
+    if (frames.size() < 2) return false;
+    const int a = anchor >= 0 ? anchor : frames.front();
+    int b = -1;
+    double widest = -1.0;
+    const Eigen::Vector3d centre_a = centreOf(*model->poses[a]);
+    for (int f : frames) {
+      const double d = (centreOf(*model->poses[f]) - centre_a).norm();
+      if (f != a && d > widest) {
+        widest = d;
+        b = f;
+      }
+    }
+    if (b < 0) return false;
+    Eigen::Vector3d point;
+    if (!triangulateDlt({*model->poses[a], *model->poses[b]},
+                        {camera->pixelToNormalized(pixelOf(track, a)),
+                         camera->pixelToNormalized(pixelOf(track, b))},
+                        &point)) {
+      return false;
+    }
+    if (!reprojects(*model, a, track, point) || !reprojects(*model, b, track, point) ||
+        triangulationAngleDeg(centre_a, centreOf(*model->poses[b]), point) <
+            options.min_triangulation_angle_deg) {
+      return false;
+    }
+    std::vector<int> kept;
+    for (int f : frames) {
+      if (f == a || f == b || reprojects(*model, f, track, point)) kept.push_back(f);
+    }
+    model->addPoint(point, track, kept);
+    return true;
+  }
+
+  // Triangulates every track seen in `frame` that has no point yet; returns how many.
+  int triangulateFrame(Model* model, int frame) const {
+    int added = 0;
+    for (int track : tracks.frame_tracks[frame]) {
+      if (model->point_of_track[track] < 0 && triangulateTrack(model, track, frame)) ++added;
+    }
+    return added;
+  }
+
+  int retriangulateAll(Model* model) const {
+    int added = 0;
+    for (int track = 0; track < static_cast<int>(tracks.tracks.size()); ++track) {
+      if (model->point_of_track[track] < 0 && triangulateTrack(model, track, -1)) ++added;
+    }
+    return added;
+  }
+
+  // Drops observations beyond the reprojection bound, then points with fewer than two frames or
+  // too small an angle. Returns the points removed.
+  int filterPoints(Model* model, const std::vector<int>& candidates) const {
+    int removed = 0;
+    for (int p : candidates) {
+      MapPoint& point = model->points[p];
+      if (!point.alive()) continue;
+      std::vector<int> kept;
+      for (int f : point.frames) {
+        if (reprojects(*model, f, point.track, point.position)) kept.push_back(f);
+      }
+      point.frames = kept;
+      if (point.frames.size() < 2 ||
+          angleDeg(*model, point.frames, point.position) < options.min_triangulation_angle_deg) {
+        model->removePoint(p);
+        ++removed;
+      }
+    }
+    return removed;
+  }
+
+  std::vector<int> allPoints(const Model& model) const {
+    std::vector<int> all(model.points.size());
+    std::iota(all.begin(), all.end(), 0);
+    return all;
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Bundle adjustment.
+
+  // Refines the poses of `free_frames` and every point they see, holding the other frames that
+  // see those points; the gauge as in the header (step 5).
+  void bundleAdjust(Model* model, const std::vector<int>& free_frames, const std::string& scope,
+                    int model_id) {
+    const Clock::time_point start = Clock::now();
+    const std::set<int> free(free_frames.begin(), free_frames.end());
+    std::vector<int> points;
+    std::set<int> frames(free.begin(), free.end());
+    for (int p = 0; p < static_cast<int>(model->points.size()); ++p) {
+      const MapPoint& point = model->points[p];
+      if (!point.alive()) continue;
+      if (std::none_of(point.frames.begin(), point.frames.end(),
+                       [&](int f) { return free.count(f) > 0; })) {
+        continue;
+      }
+      points.push_back(p);
+      frames.insert(point.frames.begin(), point.frames.end());
+    }
+    if (points.empty()) return;
+
+    // Cameras in the order the gauge needs: the pair first when present, then by frame.
+    std::vector<int> cameras;
+    for (int f : {model->pair.first, model->pair.second}) {
+      if (frames.count(f)) cameras.push_back(f);
+    }
+    for (int f : frames) {
+      if (f != model->pair.first && f != model->pair.second) cameras.push_back(f);
+    }
+    std::map<int, int> camera_index;
+    PointBundleAdjustmentInput input;
+    input.camera = camera;
+    for (int f : cameras) {
+      camera_index[f] = static_cast<int>(input.cam_from_world.size());
+      input.cam_from_world.push_back(*model->poses[f]);
+    }
+    for (int p : points) {
+      const MapPoint& point = model->points[p];
+      const int index = static_cast<int>(input.points.size());
+      input.points.push_back(point.position);
+      for (int f : point.frames) {
+        input.observations.push_back({camera_index.at(f), index, pixelOf(point.track, f)});
+      }
+    }
+    const int held = static_cast<int>(cameras.size() - free.size());
+    PointBundleAdjustmentOptions ba = options.ba;
+    // Two held frames fix all seven degrees of freedom; otherwise hold the reference frame and
+    // the distance to the pair's second frame, as in two-view BA.
+    const bool pair_in =
+        cameras.size() >= 2 && cameras[0] == model->pair.first && cameras[1] == model->pair.second;
+    ba.fix_first_pose = held < 2 && pair_in;
+    ba.fix_scale = held < 2 && pair_in;
+    PointBundleAdjustmentProblem problem = buildPointBundleAdjustment(input, ba);
+    for (std::size_t i = 0; i < cameras.size(); ++i) {
+      if (!free.count(cameras[i])) problem.config.setConstant(poseKey(i));
+    }
+    if (held < 2 && !pair_in) {
+      // No pair and fewer than two held frames: hold the oldest two so the gauge stays put.
+      for (std::size_t i = 0; i < std::min<std::size_t>(2, cameras.size()); ++i) {
+        problem.config.setConstant(poseKey(i));
+      }
+    }
+    const OptimizerOptions& solver = scope == "local" ? options.local_ba : options.global_ba;
+    InitialiserBundleAdjustment report;
+    report.scope = scope;
+    report.model = model_id;
+    report.frames = static_cast<int>(cameras.size());
+    report.points = static_cast<int>(points.size());
+    report.observations = static_cast<int>(input.observations.size());
+    report.summary = optimize(problem.graph, &problem.values, problem.config, solver);
+    const std::vector<Pose3> poses = extractPoses(problem.values, cameras.size());
+    for (std::size_t i = 0; i < cameras.size(); ++i) model->poses[cameras[i]] = poses[i];
+    const std::vector<Eigen::Vector3d> positions = extractPoints(problem.values, points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+      model->points[points[i]].position = positions[i];
+    report.summary.full_report.clear();  // Kept small: the report holds many solves.
+    out.bundle_adjustments.push_back(std::move(report));
+    (scope == "local" ? out.seconds.local_ba : out.seconds.global_ba) += secondsSince(start);
+  }
+
+  void globalRefinement(Model* model, int model_id) {
+    bundleAdjust(model, model->registration_order, "global", model_id);
+    const Clock::time_point start = Clock::now();
+    filterPoints(model, allPoints(*model));
+    const int added = retriangulateAll(model);
+    out.seconds.triangulation += secondsSince(start);
+    if (added > 0) bundleAdjust(model, model->registration_order, "global", model_id);
+    model->registered_at_last_global_ba = model->registered();
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Initial pair.
+
+  struct PairCandidate {
+    int a = -1, b = -1;
+    double score = -1.0;
+    std::vector<int> shared;
+    TwoViewGeometry geometry;
+  };
+
+  double medianFlow(const std::vector<int>& shared, int a, int b) const {
+    std::vector<double> flow;
+    flow.reserve(shared.size());
+    for (int t : shared) flow.push_back((pixelOf(t, a) - pixelOf(t, b)).norm());
+    return median(flow);
+  }
+
+  std::optional<PairCandidate> findInitialPair(const std::vector<bool>& available,
+                                               std::map<std::string, int>* rejections) {
+    const Clock::time_point start = Clock::now();
+    TwoViewOptions two_view = options.two_view;
+    two_view.min_median_parallax_deg = options.min_pair_median_parallax_deg;
+    std::optional<PairCandidate> best;
+    int searched = 0;
+    for (int a = 0; a < numFrames() && searched < options.pair_search_frames; ++a) {
+      if (!available[a]) continue;
+      ++searched;
+      double next_flow = options.min_pair_flow_px;
+      for (int b = a + 1; b < numFrames() && b - a <= options.max_pair_gap; ++b) {
+        if (!available[b]) continue;
+        std::vector<int> shared = tracks.sharedTracks(a, b);
+        if (static_cast<int>(shared.size()) < two_view.min_matches) {
+          ++(*rejections)["too_few_shared_tracks"];
+          continue;
+        }
+        const double flow = medianFlow(shared, a, b);
+        if (flow < next_flow) {
+          ++(*rejections)[flow < options.min_pair_flow_px ? "too_little_flow" : "flow_step"];
+          continue;
+        }
+        next_flow = std::max(next_flow, options.pair_flow_step * flow);
+        std::vector<Eigen::Vector2d> pa, pb;
+        for (int t : shared) {
+          pa.push_back(pixelOf(t, a));
+          pb.push_back(pixelOf(t, b));
+        }
+        ++out.pairs_tried;
+        TwoViewGeometry g = estimateTwoViewGeometry(*camera, pa, pb, two_view);
+        if (!g.accepted) {
+          ++(*rejections)[toString(g.rejection)];
+          continue;
+        }
+        const double score =
+            g.num_inliers * std::min(g.median_parallax_deg, options.pair_parallax_cap_deg);
+        if (!best || score > best->score) best = PairCandidate{a, b, score, shared, std::move(g)};
+      }
+    }
+    out.seconds.pair_search += secondsSince(start);
+    return best;
+  }
+
+  Model startModel(const PairCandidate& pair, int model_id) {
+    Model model(numFrames(), static_cast<int>(tracks.tracks.size()));
+    model.pair = {pair.a, pair.b};
+    model.registerFrame(pair.a, Pose3());
+    model.registerFrame(pair.b, pair.geometry.cam_b_from_cam_a);
+    for (std::size_t i = 0; i < pair.geometry.points_in_cam_a.size(); ++i) {
+      model.addPoint(pair.geometry.points_in_cam_a[i], pair.shared[pair.geometry.point_indices[i]],
+                     {pair.a, pair.b});
+    }
+    bundleAdjust(&model, {pair.a, pair.b}, "two_view", model_id);
+    filterPoints(&model, allPoints(model));
+    normaliseScale(&model);
+    return model;
+  }
+
+  // The gauge's scale: the median depth of the pair's points in its first frame becomes 1.
+  void normaliseScale(Model* model) const {
+    std::vector<double> depths;
+    for (const MapPoint& p : model->points) {
+      if (p.alive()) depths.push_back((*model->poses[model->pair.first] * p.position).z());
+    }
+    const double scale = median(depths);
+    if (!(scale > 0.0)) return;
+    for (MapPoint& p : model->points) p.position /= scale;
+    for (auto& pose : model->poses) {
+      if (pose) pose = Pose3(pose->rotation(), pose->translation() / scale);
+    }
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Registration.
+
+  // Unregistered frames that see model points, most first (ties: lower frame).
+  std::vector<std::pair<int, int>> registrationCandidates(const Model& model) const {
+    std::vector<std::pair<int, int>> candidates;  // (-count, frame) sorts as wanted.
+    for (int f = 0; f < numFrames(); ++f) {
+      if (model.poses[f]) continue;
+      int count = 0;
+      for (int t : tracks.frame_tracks[f]) count += model.point_of_track[t] >= 0;
+      if (count > 0) candidates.emplace_back(-count, f);
+    }
+    std::sort(candidates.begin(), candidates.end());
+    return candidates;
+  }
+
+  bool registerNext(Model* model, int model_id) {
+    const std::vector<std::pair<int, int>> candidates = registrationCandidates(*model);
+    const int trials =
+        std::min<int>(options.max_registration_trials, static_cast<int>(candidates.size()));
+    for (int c = 0; c < trials; ++c) {
+      const int frame = candidates[c].second;
+      if (tryRegister(model, frame, model_id)) return true;
+    }
+    return false;
+  }
+
+  bool tryRegister(Model* model, int frame, int model_id) {
+    const Clock::time_point start = Clock::now();
+    std::vector<int> point_ids;
+    std::vector<Eigen::Vector3d> points;
+    std::vector<Eigen::Vector2d> pixels;
+    for (int t : tracks.frame_tracks[frame]) {
+      const int p = model->point_of_track[t];
+      if (p < 0) continue;
+      point_ids.push_back(p);
+      points.push_back(model->points[p].position);
+      pixels.push_back(pixelOf(t, frame));
+    }
+    const AbsolutePose pose = estimateAbsolutePose(*camera, points, pixels, options.registration);
+    InitialisedFrame& status = out.frames[frame];
+    status.correspondences = static_cast<int>(points.size());
+    status.inliers = pose.num_inliers;
+    out.seconds.registration += secondsSince(start);
+    if (!pose.accepted) {
+      if (status.status != FrameRegistration::kRegistered) {
+        status.status = FrameRegistration::kRejected;
+        status.rejection = pose.rejection;
+      }
+      return false;
+    }
+    model->registerFrame(frame, pose.cam_from_world);
+    for (std::size_t i = 0; i < point_ids.size(); ++i) {
+      if (pose.inliers[i]) model->points[point_ids[i]].frames.push_back(frame);
+    }
+    const Clock::time_point triangulation = Clock::now();
+    triangulateFrame(model, frame);
+    out.seconds.triangulation += secondsSince(triangulation);
+    localRefinement(model, frame, model_id);
+    if (model->registered() >= options.global_ba_growth * model->registered_at_last_global_ba) {
+      globalRefinement(model, model_id);
+    }
+    if (progress) {
+      const auto live = std::count_if(model->points.begin(), model->points.end(),
+                                      [](const MapPoint& p) { return p.alive(); });
+      progress(model_id, model->registered(), numFrames(), static_cast<int>(live));
+    }
+    return true;
+  }
+
+  void localRefinement(Model* model, int frame, int model_id) {
+    const std::vector<int>& order = model->registration_order;
+    const int first = std::max(0, static_cast<int>(order.size()) - options.local_ba_frames);
+    const std::vector<int> window(order.begin() + first, order.end());
+    bundleAdjust(model, window, "local", model_id);
+    std::vector<int> seen;
+    for (int t : tracks.frame_tracks[frame]) {
+      if (model->point_of_track[t] >= 0) seen.push_back(model->point_of_track[t]);
+    }
+    filterPoints(model, seen);
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Models.
+
+  std::vector<Model> buildModels() {
+    std::vector<Model> models;
+    std::vector<bool> available(numFrames(), true);
+    std::map<std::string, int> rejections;
+    while (static_cast<int>(models.size()) < options.max_models) {
+      if (std::count(available.begin(), available.end(), true) < 2) break;
+      const std::optional<PairCandidate> pair = findInitialPair(available, &rejections);
+      if (!pair) break;
+      const int id = static_cast<int>(models.size());
+      if (id == 0) {
+        out.initial_pair = {pair->a, pair->b};
+        out.initial_geometry = pair->geometry;
+      }
+      Model model = startModel(*pair, id);
+      while (registerNext(&model, id)) {
+      }
+      globalRefinement(&model, id);
+      for (int f : model.registration_order) available[f] = false;
+      models.push_back(std::move(model));
+    }
+    out.models = static_cast<int>(models.size());
+    if (models.empty()) out.failure = noPairMessage(rejections);
+    return models;
+  }
+
+  std::string noPairMessage(const std::map<std::string, int>& rejections) const {
+    std::ostringstream message;
+    message << "no initial pair among the first " << options.pair_search_frames
+            << " frames (pairs up to " << options.max_pair_gap << " frames apart, "
+            << tracks.tracks.size() << " tracks):";
+    for (const auto& [reason, count] : rejections) message << " " << reason << " " << count << ",";
+    message << " too little texture or motion for points";
+    return message.str();
+  }
+
+  // The Sim(3) taking `source`'s map onto `target`'s through the tracks both triangulated, with
+  // one inlier pass (residuals within 3 x their median); nullopt with too few shared points.
+  std::optional<Sim3> mergeTransform(const Model& source, const Model& target) const {
+    std::vector<Eigen::Vector3d> from, to;
+    for (const MapPoint& p : source.points) {
+      if (!p.alive() || target.point_of_track[p.track] < 0) continue;
+      from.push_back(p.position);
+      to.push_back(target.points[target.point_of_track[p.track]].position);
+    }
+    if (static_cast<int>(from.size()) < options.min_merge_points) return std::nullopt;
+    const auto fit = [](const std::vector<Eigen::Vector3d>& a,
+                        const std::vector<Eigen::Vector3d>& b) -> std::optional<Sim3> {
+      Eigen::Matrix3Xd source_points(3, a.size()), target_points(3, b.size());
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        source_points.col(i) = a[i];
+        target_points.col(i) = b[i];
+      }
+      if (!hasSpreadForScale(source_points)) return std::nullopt;
+      return alignPointSets(source_points, target_points, AlignmentKind::kSim3);
+    };
+    std::optional<Sim3> first = fit(from, to);
+    if (!first) return std::nullopt;
+    std::vector<double> residuals;
+    for (std::size_t i = 0; i < from.size(); ++i)
+      residuals.push_back((*first * from[i] - to[i]).norm());
+    const double bound = 3.0 * median(residuals);
+    std::vector<Eigen::Vector3d> inlier_from, inlier_to;
+    for (std::size_t i = 0; i < from.size(); ++i) {
+      if (residuals[i] <= bound) {
+        inlier_from.push_back(from[i]);
+        inlier_to.push_back(to[i]);
+      }
+    }
+    if (static_cast<int>(inlier_from.size()) < options.min_merge_points) return std::nullopt;
+    return fit(inlier_from, inlier_to);
+  }
+
+  // Carries `source` into `target` by `t`: its frames and points that `target` lacks.
+  void mergeInto(const Model& source, const Sim3& t, Model* target) const {
+    for (int f : source.registration_order) {
+      if (target->poses[f]) continue;
+      target->registerFrame(f, t.transformPose(source.poses[f]->inverse()).inverse());
+    }
+    for (const MapPoint& p : source.points) {
+      if (!p.alive()) continue;
+      if (target->point_of_track[p.track] >= 0) {
+        // Shared: the observations of frames the target took from the source join its point.
+        MapPoint& q = target->points[target->point_of_track[p.track]];
+        for (int f : p.frames) {
+          if (std::find(q.frames.begin(), q.frames.end(), f) == q.frames.end())
+            q.frames.push_back(f);
+        }
+        continue;
+      }
+      target->addPoint(t * p.position, p.track, p.frames);
+    }
+  }
+
+  // The largest model absorbs every other one it can be aligned with; the rest stay apart.
+  Model mergeModels(std::vector<Model> models, std::vector<int>* model_of_frame) {
+    const Clock::time_point start = Clock::now();
+    int reference = 0;
+    for (int m = 1; m < static_cast<int>(models.size()); ++m) {
+      if (models[m].registered() > models[reference].registered()) reference = m;
+    }
+    Model merged = models[reference];
+    for (int f : merged.registration_order) (*model_of_frame)[f] = reference;
+    out.merged_models = 1;
+    bool merged_any = false;
+    for (int m = 0; m < static_cast<int>(models.size()); ++m) {
+      if (m == reference) continue;
+      const std::optional<Sim3> t = mergeTransform(models[m], merged);
+      if (!t) continue;
+      for (int f : models[m].registration_order) {
+        if (!merged.poses[f]) (*model_of_frame)[f] = m;
+      }
+      mergeInto(models[m], *t, &merged);
+      ++out.merged_models;
+      merged_any = true;
+    }
+    out.seconds.merge += secondsSince(start);
+    if (merged_any) globalRefinement(&merged, reference);
+    return merged;
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Output.
+
+  void writeResult(const Model& merged, const std::vector<Model>& models,
+                   const std::vector<int>& model_of_frame) {
+    for (int f = 0; f < numFrames(); ++f) {
+      InitialisedFrame& frame = out.frames[f];
+      if (merged.poses[f]) {
+        frame.status = FrameRegistration::kRegistered;
+        frame.model = model_of_frame[f];
+        frame.cam_from_world = merged.poses[f];
+        continue;
+      }
+      const bool elsewhere = std::any_of(models.begin(), models.end(),
+                                         [f](const Model& m) { return m.poses[f].has_value(); });
+      if (elsewhere) {
+        frame.status = FrameRegistration::kUnmergedModel;
+      } else if (frame.status == FrameRegistration::kNotTried && !tracks.frame_tracks[f].empty()) {
+        frame.status = FrameRegistration::kNoCorrespondences;
+      }
+    }
+    for (const MapPoint& p : merged.points) {
+      if (!p.alive()) continue;
+      InitialisedPoint point;
+      point.position = p.position;
+      point.colour_bgr = tracks.tracks[p.track].colour_bgr;
+      std::vector<int> frames = p.frames;
+      std::sort(frames.begin(), frames.end());
+      for (int f : frames) point.observations.push_back({f, pixelOf(p.track, f)});
+      out.points.push_back(std::move(point));
+    }
+  }
+
+  void addFrame(const cv::Mat& image) {
+    CURVESFM_CHECK(image.cols == camera->width() && image.rows == camera->height())
+        << "frame " << frames_added << " is " << image.cols << "x" << image.rows
+        << " but the camera is " << camera->width() << "x" << camera->height();
+    const Clock::time_point start = Clock::now();
+    const cv::Mat undistorted = undistorter.undistort(image);
+    out.seconds.undistort += secondsSince(start);
+    builder.addFrame(undistorted);
+    ++frames_added;
+    add_frame_seconds += secondsSince(start);
+  }
+
+  PointInitialisation finish() {
+    const Clock::time_point start = Clock::now();
+    tracks = builder.finish();
+    out.num_tracks = static_cast<int>(tracks.tracks.size());
+    out.track_stats = tracks.frames;
+    for (const FeatureTrackFrameStats& s : tracks.frames) {
+      out.seconds.klt += s.klt_seconds;
+      out.seconds.matching += s.match_seconds;
+    }
+    out.frames.assign(numFrames(), InitialisedFrame{});
+    std::vector<Model> models = buildModels();
+    if (!models.empty()) {
+      std::vector<int> model_of_frame(numFrames(), -1);
+      const Model merged = mergeModels(models, &model_of_frame);
+      writeResult(merged, models, model_of_frame);
+    } else {
+      writeResult(Model(numFrames(), 0), models, std::vector<int>(numFrames(), -1));
+    }
+    out.seconds.total = add_frame_seconds + secondsSince(start);
+    return std::move(out);
+  }
+};
+
+PointInitialiser::PointInitialiser(const Camera& camera, const PointInitialiserOptions& options)
+    : state_(std::make_unique<State>(camera, options)) {}
+
+PointInitialiser::~PointInitialiser() = default;
+
+void PointInitialiser::addFrame(const cv::Mat& image) { state_->addFrame(image); }
+
+PointInitialisation PointInitialiser::finish() { return state_->finish(); }
+
+const Camera& PointInitialiser::undistortedCamera() const { return *state_->camera; }
+
+void PointInitialiser::setProgress(Progress progress) { state_->progress = std::move(progress); }
+
+}  // namespace curvesfm

@@ -1,0 +1,207 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <functional>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/enum_names.h"
+#include "core/pose3.h"
+#include "factors/point_bundle_adjustment.h"
+#include "frontend/image/absolute_pose.h"
+#include "frontend/image/feature_tracks.h"
+#include "frontend/image/image_undistorter.h"
+#include "frontend/image/two_view_geometry.h"
+#include "graph/optimizer.h"
+
+namespace curvesfm {
+
+// The point-based initialiser (issue 13): initial camera poses and a sparse point map from a
+// calibrated image sequence alone, so that the curve pipeline needs nothing but the images. It is
+// an incremental structure from motion in the manner of COLMAP, on the frontend's tracks
+// (feature_tracks.h) and our own point bundle adjustment (factors/point_bundle_adjustment.h);
+// every decision is anchored in ../shared/reviews/initialiser_anchors.md A.5:
+//  1. Tracks: KLT between consecutive frames plus descriptor matches between matching frames.
+//  2. Initial pair: among pairs (i, j) with i in the first pair_search_frames frames (of the
+//     frames no model holds yet) and 0 < j - i <= max_pair_gap (j stepped by their median flow,
+//     see pair_flow_step), estimateTwoViewGeometry on their
+//     shared tracks, with the median triangulation angle gated at min_pair_median_parallax_deg;
+//     the accepted pair with the highest inliers x min(median angle, pair_parallax_cap_deg) wins
+//     (OpenMVG's and COLMAP's preference for wide, well-supported pairs, not the first that
+//     works). Two-view BA follows, then the gauge: the first frame of the pair is the world
+//     frame, and the scale makes the median depth of its points 1 (so the map's unit is "median
+//     scene depth at the start", written in the report).
+//  3. Registration: the unregistered frame that sees the most map points next; PnP in RANSAC and
+//     refinement (absolute_pose.h); up to max_registration_trials candidates per step.
+//  4. Triangulation of every track the new frame shares with registered frames and no point yet:
+//     from the new frame and the registered observation of widest angle, gated by angle
+//     (min_triangulation_angle_deg), cheirality and reprojection (max_reprojection_error_px);
+//     the track's other registered observations join when they reproject within the same bound.
+//  5. Local BA over the new frame and the local_ba_frames - 1 frames registered just before it
+//     (the points they see free, the other frames that see those points held); global BA when
+//     the model has grown by global_ba_growth since the last one, and at the end. After each
+//     global BA, observations beyond max_reprojection_error_px are dropped, points below the
+//     angle gate removed, and tracks re-triangulated.
+//  6. Recovery: when no frame registers, the model is closed and a new one starts from the best
+//     pair among the frames no model holds (at most max_models). Models are merged into the
+//     first by the Sim(3) fitted (Umeyama, with an inlier pass) on the tracks both triangulated;
+//     a model that shares too few is reported apart and its frames count as unregistered.
+//
+// Pixels: the images may be distorted; they are undistorted once (ImageUndistorter), and every
+// pixel of the result (point observations) is an undistorted pixel of undistortedCamera().
+
+/// Thresholds of the incremental reconstruction (defaults: COLMAP's and ORB-SLAM's, see above).
+struct PointInitialiserOptions {
+  ImageUndistorterOptions undistort;
+  PointTrackerOptions klt;           ///< KLT between consecutive frames.
+  FeatureMatchingOptions features;   ///< Descriptors between matching frames.
+  FeatureTrackOptions tracks;        ///< When descriptors are matched and joined to KLT.
+  TwoViewOptions two_view;           ///< The initial pair's geometry and acceptance.
+  AbsolutePoseOptions registration;  ///< PnP registration of the next frames.
+  PointBundleAdjustmentOptions ba;   ///< Objective of every BA (pixel sigma, robust kernel).
+  OptimizerOptions local_ba = defaultLocalSolver();    ///< Solver of local BA.
+  OptimizerOptions global_ba = defaultGlobalSolver();  ///< Solver of global BA.
+  /// The initial pair's first frame is searched among this many frames (count). >= 1.
+  int pair_search_frames = 20;
+  /// Most frames between the initial pair's two frames (count): slow video needs a wide gap
+  /// for parallax (7-Scenes moves about 7 mm a frame at 1-3 m). >= 1.
+  int max_pair_gap = 60;
+  /// Pairs whose shared tracks move by less than this median distance are not tried (px): they
+  /// cannot have parallax, and skipping them keeps the search fast on video. Finite, >= 0.
+  double min_pair_flow_px = 10.0;
+  /// For one first frame, a second frame is tried only when its median flow exceeds the last
+  /// tried one's by this factor (unitless): the pairs of a slow sequence differ little from
+  /// one frame to the next, and this bounds the fits per first frame to a few. >= 1 (1: all).
+  double pair_flow_step = 1.25;
+  /// Smallest median triangulation angle of the initial pair (deg; COLMAP 16, too strict for
+  /// hand-held video per the anchors, which suggest 4-8). In [0, 90).
+  double min_pair_median_parallax_deg = 4.0;
+  /// The pair score counts the median angle up to this (deg): beyond it, more inliers win.
+  /// In (0, 90].
+  double pair_parallax_cap_deg = 20.0;
+  /// Largest reprojection error of an observation kept in the map (px; COLMAP 4). Finite, > 0.
+  double max_reprojection_error_px = 4.0;
+  /// Smallest angle between the rays of a triangulated point (deg; COLMAP 1.5). In [0, 90).
+  double min_triangulation_angle_deg = 1.5;
+  /// Frames refined by local BA: the new frame and those registered just before it (count).
+  /// >= 1.
+  int local_ba_frames = 6;
+  /// Global BA runs when the registered frames have grown by this factor since the last one
+  /// (unitless; COLMAP 1.1, here 1.2 to halve the solves on long video), and at the end. > 1.
+  double global_ba_growth = 1.2;
+  /// Candidates tried per registration step before the model is declared stuck (count). >= 1.
+  int max_registration_trials = 5;
+  /// Most sub-models started (the first included) before giving up on the rest (count). >= 1.
+  int max_models = 5;
+  /// Fewest tracks two models must both have triangulated to be merged (count). >= 3.
+  int min_merge_points = 20;
+  /// Throws InvalidOptions naming the first field outside its range (also of the nested ones).
+  void validate() const;
+
+  static OptimizerOptions defaultLocalSolver();
+  static OptimizerOptions defaultGlobalSolver();
+};
+
+/// Why a frame is not in the reconstruction.
+enum class FrameRegistration {
+  kRegistered,         ///< Has a pose.
+  kNoCorrespondences,  ///< No model point is seen in it (tracks lost).
+  kRejected,           ///< PnP tried and rejected it (see the rejection).
+  kNotTried,           ///< The models stopped before this frame came up (too many failures).
+  kUnmergedModel,      ///< Registered in a sub-model that could not be merged with the first.
+};
+
+template <>
+struct EnumNames<FrameRegistration> {
+  static constexpr std::array<std::pair<FrameRegistration, const char*>, 5> kNames = {
+      {{FrameRegistration::kRegistered, "registered"},
+       {FrameRegistration::kNoCorrespondences, "no_correspondences"},
+       {FrameRegistration::kRejected, "rejected"},
+       {FrameRegistration::kNotTried, "not_tried"},
+       {FrameRegistration::kUnmergedModel, "unmerged_model"}}};
+};
+
+/// One frame of the result.
+struct InitialisedFrame {
+  FrameRegistration status = FrameRegistration::kNotTried;
+  /// For kRejected: PnP's last rejection of it.
+  AbsolutePoseRejection rejection = AbsolutePoseRejection::kNone;
+  int model = -1;           ///< The sub-model that registered it (0 = the first), or -1.
+  int correspondences = 0;  ///< 2D-3D correspondences at its (last) registration attempt.
+  int inliers = 0;          ///< PnP inliers of that attempt.
+  std::optional<Pose3> cam_from_world;  ///< Set when registered.
+};
+
+/// One point of the map.
+struct InitialisedPoint {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< World, in the map's unit.
+  cv::Vec3b colour_bgr = cv::Vec3b(0, 0, 0);           ///< Where it was first seen.
+  /// Its observations in registered frames (undistorted pixels), by frame.
+  std::vector<TrackObservation> observations;
+};
+
+/// One bundle adjustment the initialiser ran.
+struct InitialiserBundleAdjustment {
+  std::string scope;  ///< "two_view", "local" or "global".
+  int model = 0;
+  int frames = 0, points = 0, observations = 0;
+  OptimizationSummary summary;
+};
+
+/// Wall time of each stage (s).
+struct InitialiserTimes {
+  double undistort = 0.0, klt = 0.0, matching = 0.0, pair_search = 0.0, registration = 0.0,
+         triangulation = 0.0, local_ba = 0.0, global_ba = 0.0, merge = 0.0, total = 0.0;
+};
+
+/// What the initialiser made of the sequence.
+struct PointInitialisation {
+  std::vector<InitialisedFrame> frames;  ///< One per frame given, in order.
+  std::vector<InitialisedPoint> points;  ///< The merged map.
+  int num_tracks = 0;                    ///< Tracks of at least two frames.
+  int models = 0;                        ///< Sub-models started.
+  int merged_models = 0;                 ///< Of those, merged into the first (itself included).
+  std::pair<int, int> initial_pair = {-1, -1};  ///< Frames of the first model's pair.
+  TwoViewGeometry initial_geometry;             ///< Its two-view geometry.
+  int pairs_tried = 0;                          ///< Pair candidates evaluated, all models.
+  /// The gauge: map unit = median depth of the initial pair's points in its first frame.
+  std::string scale_convention = "median depth of the initial pair's points = 1";
+  std::vector<InitialiserBundleAdjustment> bundle_adjustments;
+  std::vector<FeatureTrackFrameStats> track_stats;  ///< Per frame.
+  InitialiserTimes seconds;
+  int registeredFrames() const;
+  /// Why nothing could be reconstructed; empty when a model exists.
+  std::string failure;
+};
+
+/// Runs the initialiser over a sequence: feed every frame in order, then finish(). Not
+/// thread-safe.
+class PointInitialiser {
+ public:
+  /// `camera` is the dataset's (possibly distorted) camera. Throws InvalidOptions for bad options.
+  PointInitialiser(const Camera& camera, const PointInitialiserOptions& options);
+  ~PointInitialiser();
+  /// Tracks the frame (8-bit BGR or grey, the camera's size; CheckError otherwise).
+  void addFrame(const cv::Mat& image);
+  /// Reconstructs from the tracks. Never throws on hard data: failure and per-frame reasons say
+  /// what could not be done.
+  PointInitialisation finish();
+  /// The pinhole camera of the undistorted images, which every result pixel refers to.
+  const Camera& undistortedCamera() const;
+  /// Called by finish() after every registered frame with (model, frames registered in it,
+  /// frames given, live points in it): a long reconstruction shows its progress.
+  using Progress = std::function<void(int model, int registered, int frames, int points)>;
+  void setProgress(Progress progress);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace curvesfm

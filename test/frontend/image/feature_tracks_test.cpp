@@ -1,0 +1,88 @@
+#include "frontend/image/feature_tracks.h"
+
+#include <gtest/gtest.h>
+
+#include "core/errors.h"
+#include "sim/planar_scene.h"
+#include "test/support/textures.h"
+
+namespace curvesfm {
+namespace {
+
+// Ten views of the textured plane, 3 deg of orbit apart.
+const PlanarScene& scene() {
+  static const PlanarScene kScene = [] {
+    PlanarSceneOptions options;
+    options.num_frames = 10;
+    options.arc_degrees = 27.0;
+    options.intensity_noise = 0.01;
+    return makePlanarScene(testing::denseTexture(), options);
+  }();
+  return kScene;
+}
+
+Eigen::Vector2d mapPixel(const Eigen::Matrix3d& h, const Eigen::Vector2d& p) {
+  return (h * p.homogeneous()).hnormalized();
+}
+
+// Feeds `frames` (scene frame indices; -1 is an all-black frame) and returns the tracks.
+FeatureTracks build(const std::vector<int>& frames, const FeatureTrackOptions& options = {}) {
+  FeatureTrackBuilder builder(options, {}, {});
+  const cv::Mat black = cv::Mat::zeros(scene().images[0].size(), scene().images[0].type());
+  for (int f : frames) builder.addFrame(f < 0 ? black : scene().images[f]);
+  return builder.finish();
+}
+
+// The fraction of tracks whose every observation lies within 2 px of where the true homography
+// carries its first one.
+double consistentFraction(const FeatureTracks& tracks, const std::vector<int>& frames) {
+  int consistent = 0;
+  for (const FeatureTrack& track : tracks.tracks) {
+    const TrackObservation& first = track.observations.front();
+    bool ok = true;
+    for (const TrackObservation& o : track.observations) {
+      const Eigen::Matrix3d h = scene().pixelMap(frames[first.frame], frames[o.frame]);
+      ok = ok && (mapPixel(h, first.pixel) - o.pixel).norm() < 3.0;
+    }
+    consistent += ok;
+  }
+  return tracks.tracks.empty() ? 0.0 : double(consistent) / tracks.tracks.size();
+}
+
+TEST(FeatureTracks, JoinKltAndDescriptorsIntoConsistentTracks) {
+  const std::vector<int> frames = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+  const FeatureTracks tracks = build(frames);
+  ASSERT_EQ(tracks.num_frames, 10);
+  EXPECT_GT(tracks.tracks.size(), 300u);
+  EXPECT_GT(consistentFraction(tracks, frames), 0.97);
+  FeatureTrackOptions klt_only;
+  klt_only.match_overlap = 0;
+  EXPECT_GT(consistentFraction(build(frames, klt_only), frames), 0.97);
+  // Matching frames: every fifth and the last.
+  EXPECT_TRUE(tracks.frames[0].matching_frame);
+  EXPECT_FALSE(tracks.frames[1].matching_frame);
+  EXPECT_TRUE(tracks.frames[5].matching_frame);
+  EXPECT_TRUE(tracks.frames[9].matching_frame);
+  for (int f = 0; f < 10; ++f) {
+    for (int t : tracks.frame_tracks[f]) ASSERT_NE(tracks.pixel(t, f), nullptr);
+  }
+}
+
+TEST(FeatureTracks, DescriptorsBridgeAFrameWhereKltLosesEverything) {
+  // Frame 4 of the sequence is black: KLT loses every track there and starts afresh after it.
+  const std::vector<int> frames = {0, 1, 2, 3, -1, 4, 5, 6};
+  const FeatureTracks bridged = build(frames);
+  EXPECT_GT(bridged.sharedTracks(3, 5).size(), 100u);
+  FeatureTrackOptions klt_only;
+  klt_only.match_overlap = 0;
+  EXPECT_TRUE(build(frames, klt_only).sharedTracks(3, 5).empty());
+}
+
+TEST(FeatureTracks, RejectsBadOptions) {
+  FeatureTrackOptions options;
+  options.match_interval = 0;
+  EXPECT_THROW(FeatureTrackBuilder(options, {}, {}), InvalidOptions);
+}
+
+}  // namespace
+}  // namespace curvesfm

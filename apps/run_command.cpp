@@ -10,6 +10,7 @@
 
 #include "apps/cli/cli_options.h"
 #include "apps/cli/config_file.h"
+#include "apps/cli/initialisation_output.h"
 #include "apps/cli/option_tables.h"
 #include "apps/cli/report_json.h"
 #include "core/clock.h"
@@ -20,6 +21,15 @@
 #include "core/tum_dataset.h"
 
 namespace curvesfm {
+
+// The images of a run with their initial poses, wherever those came from.
+struct RunInput {
+  ImageSequence sequence;
+  std::string init_poses_source;  // A file, a COLMAP model, or "initialiser".
+  std::vector<DatasetFrame> frames;
+  std::optional<PointInitialisation> initialisation;  // When the initialiser ran.
+};
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -43,12 +53,24 @@ void printProgress(const KeyframeStats& s, int frames) {
   std::fflush(stdout);
 }
 
-std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const TumDataset& d) {
+std::vector<DatasetFrame> initialisedFrames(const ImageSequence& sequence,
+                                            const PointInitialisation& result) {
+  std::vector<DatasetFrame> frames;
+  for (std::size_t i = 0; i < result.frames.size(); ++i) {
+    if (!result.frames[i].cam_from_world) continue;
+    frames.push_back({sequence.images[i].timestamp, sequence.images[i].image_path,
+                      *result.frames[i].cam_from_world});
+  }
+  return frames;
+}
+
+std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const RunInput& input) {
   std::vector<KeyframeStats> stats;
-  const int n = static_cast<int>(d.frames.size());
-  for (const DatasetFrame& frame : d.frames) {
-    const KeyframeStats s = pipeline->addFrame(
-        {frame.timestamp, loadFrameImage(frame, *d.camera), frame.initial_cam_from_world});
+  const int n = static_cast<int>(input.frames.size());
+  for (const DatasetFrame& frame : input.frames) {
+    const KeyframeStats s =
+        pipeline->addFrame({frame.timestamp, loadFrameImage(frame, input.sequence.camera),
+                            frame.initial_cam_from_world});
     if (s.keyframe_index >= 0) printProgress(s, n);
     stats.push_back(s);
   }
@@ -61,17 +83,17 @@ struct AteResult {
   std::string problem;  // Why they are missing, if they are.
 };
 
-AteResult evaluateAte(const PipelineResult& r, const TumDataset& d) {
+AteResult evaluateAte(const PipelineResult& r, const ImageSequence& d) {
   AteResult ate;
   if (d.ground_truth.empty()) return ate;
   try {
     const TrajectoryEvaluationOptions options;  // Sim(3), 0.02 s.
     ate.initial =
         compareTrajectories(stampedPoses(r.keyframe_timestamps, r.keyframe_initial_cam_from_world),
-                            d.ground_truth, options, "initial keyframes", d.ground_truth_path);
+                            d.ground_truth, options, "initial keyframes", d.ground_truth_source);
     ate.refined =
         compareTrajectories(stampedPoses(r.keyframe_timestamps, r.keyframe_cam_from_world),
-                            d.ground_truth, options, "refined keyframes", d.ground_truth_path);
+                            d.ground_truth, options, "refined keyframes", d.ground_truth_source);
   } catch (const TrajectoryEvaluationError& e) {
     ate.problem = e.what();
   }
@@ -179,8 +201,8 @@ void writeConfigYaml(const std::string& path, const CLI::App& command) {
 void printAte(const AteResult& ate, const std::string& ground_truth_path) {
   if (ate.initial && ate.refined) {
     std::printf(
-        "ATE (sim3) vs %s over %d keyframes: initial rmse %.6f m (max %.6f), refined rmse "
-        "%.6f m (max %.6f)\n",
+        "ATE (sim3) vs %s over %d keyframes, in its unit: initial rmse %.6f (max %.6f), refined "
+        "rmse %.6f (max %.6f)\n",
         ground_truth_path.c_str(), ate.refined->ate.count, ate.initial->ate.rmse,
         ate.initial->ate.max, ate.refined->ate.rmse, ate.refined->ate.max);
   } else if (!ate.problem.empty()) {
@@ -214,7 +236,7 @@ CurveGrowth curveGrowth(const std::vector<KeyframeStats>& frames) {
   return growth;
 }
 
-void printSummary(const TumDataset& d, const PipelineResult& r, double seconds) {
+void printSummary(const RunInput& input, const PipelineResult& r, double seconds) {
   double frontend = 0.0, local_ba = 0.0;
   for (const KeyframeStats& s : r.frames) {
     frontend += s.frontendSeconds();
@@ -222,10 +244,11 @@ void printSummary(const TumDataset& d, const PipelineResult& r, double seconds) 
   }
   const CurveGrowth growth = curveGrowth(r.frames);
   const CurveSampleCounts& samples = r.final_samples;
+  const int images = static_cast<int>(input.sequence.images.size());
   std::printf(
       "run: %zu frames (%d of %d images without an initial pose skipped), %zu keyframes, "
       "%zu curves (%d segments) in the global map\n",
-      d.frames.size(), d.images - static_cast<int>(d.frames.size()), d.images,
+      input.frames.size(), images - static_cast<int>(input.frames.size()), images,
       r.keyframe_cam_from_world.size(), r.curves.size(), totalSegments(r.curves));
   std::printf("map: %d curves started, %d new curves appended to an existing curve's end\n",
               growth.started, growth.extended);
@@ -273,19 +296,21 @@ bool globalBaUsable(const ScheduleReport& report) {
 RunCommand::RunCommand(CLI::App* app) {
   command_ = app->add_subcommand(
       "run",
-      "Curve structure from motion on a TUM RGB-D layout dataset (rgb.txt, camera.yaml, initial "
-      "poses): writes trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, report.json, "
+      "Curve structure from motion on a calibrated image sequence in any layout of the README, "
+      "from given initial poses or, without them, from the point-based initialiser's: writes "
+      "trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, report.json, "
       "config.yaml and, with --overlays, the curves drawn on each keyframe; `curvesfm report` "
       "draws them.");
   addConfigFlag(command_);
   CLI::App* c = command_;
   c->add_option("--dataset", dataset_dir_,
-                "Dataset folder: rgb.txt, camera.yaml, optional groundtruth.txt and init_poses.txt")
+                "Dataset folder in any layout of the README (TUM: rgb.txt, camera.yaml, optional "
+                "groundtruth.txt and init_poses.txt)")
       ->required();
   c->add_option("--out", out_dir_, "Output folder (created if needed)")->required();
   c->add_option("--init-poses", init_poses_path_,
-                "Initial poses, TUM lines 'timestamp tx ty tz qx qy qz qw' (camera-to-world); "
-                "default DATASET/init_poses.txt");
+                "Initial poses: a TUM file 'timestamp tx ty tz qx qy qz qw' (camera-to-world) or a "
+                "COLMAP model folder; default DATASET/init_poses.txt, else the point initialiser");
   c->add_option("--max-dt", max_dt_,
                 "Largest time difference between an image and its initial pose (s)")
       ->capture_default_str();
@@ -294,6 +319,8 @@ RunCommand::RunCommand(CLI::App* app) {
   c->add_option("--export-samples", export_samples_per_segment_,
                 "Samples per segment of the curves in curves.ply and curves.obj")
       ->capture_default_str();
+  addImageSequenceOptions(&table_, &sequence_);
+  addPointInitialiserOptions(&table_, &initialiser_, "/points");
   addPipelineOptions(&table_, &options_, "/pipeline");
   addCurveOverlayOptions(&table_, &overlay_, {"/overlay", "overlay-", "Overlays", ""});
   table_.addFlags(c);
@@ -315,19 +342,49 @@ nlohmann::json RunCommand::runOptionsJson() const {
   return options;
 }
 
+RunInput RunCommand::loadInput() const {
+  RunInput input;
+  input.sequence = loadImageSequence(dataset_dir_, sequence_);
+  const std::vector<StampedPose> poses =
+      readInitialPoses(init_poses_path_, input.sequence, &input.init_poses_source);
+  if (!poses.empty()) {
+    input.frames = framesWithPoses(input.sequence, poses, max_dt_, input.init_poses_source);
+    return input;
+  }
+  std::printf(
+      "run: no initial poses (no --init-poses, no %s/init_poses.txt): running the point "
+      "initialiser on the %zu images first\n",
+      dataset_dir_.c_str(), input.sequence.images.size());
+  input.init_poses_source = "initialiser";
+  input.initialisation = initialiseSequence(input.sequence, initialiser_);
+  printInitialisationSummary(input.sequence, *input.initialisation);
+  input.frames = initialisedFrames(input.sequence, *input.initialisation);
+  return input;
+}
+
 int RunCommand::run() const {
   validate();
   const Clock::time_point start = Clock::now();
-  const TumDataset d = loadTumDataset(dataset_dir_, init_poses_path_, max_dt_);
+  const RunInput input = loadInput();
+  const ImageSequence& d = input.sequence;
+  if (input.initialisation && input.frames.size() < 2) {
+    std::fflush(stdout);  // The initialiser's summary first, then why the run stops.
+    std::fprintf(stderr, "run: the initialiser registered %zu frames: nothing to refine (%s)\n",
+                 input.frames.size(), input.initialisation->failure.c_str());
+    return 1;
+  }
   std::error_code error;
   fs::create_directories(out_dir_, error);
   if (error) throw IoError(out_dir_, "cannot create the output folder: " + error.message());
-  std::printf("run: %s, %zu of %d images with an initial pose (%s), camera %dx%d\n",
-              dataset_dir_.c_str(), d.frames.size(), d.images, d.init_poses_path.c_str(),
-              d.camera->width(), d.camera->height());
+  if (input.initialisation) {
+    writeInitialisedPoints(joinPath(out_dir_, "points.ply"), *input.initialisation);
+  }
+  std::printf("run: %s (%s layout), %zu of %zu images with an initial pose (%s), camera %dx%d\n",
+              dataset_dir_.c_str(), d.layout.c_str(), input.frames.size(), d.images.size(),
+              input.init_poses_source.c_str(), d.camera.width(), d.camera.height());
 
-  Pipeline pipeline(*d.camera, options_);
-  feedFrames(&pipeline, d);
+  Pipeline pipeline(d.camera, options_);
+  feedFrames(&pipeline, input);
   const PipelineResult result = pipeline.finish();
   const AteResult ate = evaluateAte(result, d);
 
@@ -345,42 +402,45 @@ int RunCommand::run() const {
   for (const KeyframeStats& s : result.frames) frames.push_back(frameToJson(s));
   const double seconds = secondsSince(start);
   const CurveGrowth growth = curveGrowth(result.frames);
-  writeJsonFile(joinPath(out_dir_, "report.json"),
-                {{"command", "run"},
-                 {"curvesfm", versionJson()},
-                 {"config", optionsToJson(*command_)},
-                 {"options", runOptionsJson()},
-                 {"dataset",
-                  {{"dir", dataset_dir_},
-                   {"camera", d.camera_path},
-                   {"rgb", d.rgb_path},
-                   {"init_poses", d.init_poses_path},
-                   {"groundtruth", d.ground_truth_path},
-                   {"images", d.images},
-                   {"frames_with_initial_pose", d.frames.size()}}},
-                 {"camera", cameraToJson(pipeline.undistortedCamera())},
-                 {"counts",
-                  {{"frames", d.frames.size()},
-                   {"keyframes", result.keyframe_cam_from_world.size()},
-                   {"curves", result.curves.size()},
-                   {"segments", totalSegments(result.curves)},
-                   {"curves_started", growth.started},
-                   {"curves_extended", growth.extended},
-                   {"overlays", overlays}}},
-                 {"frames", frames},
-                 {"global_ba", scheduleReportToJson(result.global_ba)},
-                 {"global_ba_cost_by_type", globalCostsToJson(result.global_ba)},
-                 {"reassociation", reassociationToJson(result.reassociation)},
-                 {"final_samples", sampleCountsToJson(result.final_samples)},
-                 {"ate", ateToJson(ate)},
-                 {"total_seconds", seconds}});
+  writeJsonFile(
+      joinPath(out_dir_, "report.json"),
+      {{"command", "run"},
+       {"curvesfm", versionJson()},
+       {"config", optionsToJson(*command_)},
+       {"options", runOptionsJson()},
+       {"dataset",
+        {{"dir", dataset_dir_},
+         {"layout", d.layout},
+         {"camera", d.camera_source},
+         {"init_poses", input.init_poses_source},
+         {"groundtruth", d.ground_truth_source},
+         {"images", d.images.size()},
+         {"frames_with_initial_pose", input.frames.size()}}},
+       {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
+                                            : nlohmann::json(nullptr)},
+       {"camera", cameraToJson(pipeline.undistortedCamera())},
+       {"counts",
+        {{"frames", input.frames.size()},
+         {"keyframes", result.keyframe_cam_from_world.size()},
+         {"curves", result.curves.size()},
+         {"segments", totalSegments(result.curves)},
+         {"curves_started", growth.started},
+         {"curves_extended", growth.extended},
+         {"overlays", overlays}}},
+       {"frames", frames},
+       {"global_ba", scheduleReportToJson(result.global_ba)},
+       {"global_ba_cost_by_type", globalCostsToJson(result.global_ba)},
+       {"reassociation", reassociationToJson(result.reassociation)},
+       {"final_samples", sampleCountsToJson(result.final_samples)},
+       {"ate", ateToJson(ate)},
+       {"total_seconds", seconds}});
 
-  printSummary(d, result, seconds);
-  printAte(ate, d.ground_truth_path);
+  printSummary(input, result, seconds);
+  printAte(ate, d.ground_truth_source);
   std::printf(
       "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, report.json, "
-      "config.yaml%s)\n",
-      out_dir_.c_str(), overlays_ ? ", overlays/" : "");
+      "config.yaml%s%s)\n",
+      out_dir_.c_str(), input.initialisation ? ", points.ply" : "", overlays_ ? ", overlays/" : "");
   if (result.curves.empty()) {
     std::fprintf(stderr,
                  "run: no curve reached the global map: nothing was reconstructed (see "

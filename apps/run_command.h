@@ -4,17 +4,22 @@
 #include <string>
 
 #include "apps/cli/options_table.h"
+#include "core/image_sequence.h"
 #include "frontend/image/curve_overlay.h"
 #include "frontend/mapping/pipeline.h"
+#include "frontend/mapping/point_initialiser.h"
 
 namespace curvesfm {
 
-/// `curvesfm run`: the incremental curve SfM pipeline on a dataset in the TUM RGB-D layout
-/// (DESIGN.md "Data contracts"): loads camera.yaml, rgb.txt and the initial poses, feeds the
-/// frames to Pipeline printing one line per keyframe, runs global BA and writes trajectory.txt,
-/// trajectory_initial.txt (the keyframes' initial poses), curves.ply, curves.obj, report.json
-/// (incl. the undistorted camera and the per-pose ATE that `curvesfm report` draws), config.yaml
-/// (the flags in force, for --config) and, with
+struct RunInput;
+
+/// `curvesfm run`: the incremental curve SfM pipeline on a dataset in any layout of
+/// loadImageSequence (README "Dataset layouts"): takes the initial poses from --init-poses (a TUM
+/// file or a COLMAP model), DIR/init_poses.txt, or else from the point-based initialiser run on
+/// the images first; feeds the frames with a pose to Pipeline printing one line per keyframe, runs
+/// global BA and writes trajectory.txt, trajectory_initial.txt (the keyframes' initial poses),
+/// curves.ply, curves.obj, report.json (incl. the undistorted camera and the per-pose ATE that
+/// `curvesfm report` draws), config.yaml (the flags in force, for --config) and, with
 /// --overlays, the curves reprojected onto each keyframe. With DIR/groundtruth.txt it prints the
 /// ATE (Sim(3)) of the initial and the refined keyframe trajectory. Every PipelineOptions field
 /// is a flag (and so a --config key), prefixed by its stage.
@@ -31,6 +36,8 @@ class RunCommand {
   int run() const;
 
  private:
+  /// The images with their initial poses: read, or found by the point initialiser.
+  RunInput loadInput() const;
   /// Every option in force, for report.json: the table's and the run's own.
   nlohmann::json runOptionsJson() const;
 
@@ -42,6 +49,8 @@ class RunCommand {
   int export_samples_per_segment_ = 20;
   /// Largest |t_image - t_pose| of an image matched to an initial pose (s).
   double max_dt_ = 0.02;
+  ImageSequenceOptions sequence_;
+  PointInitialiserOptions initialiser_;
   PipelineOptions options_;
   CurveOverlayOptions overlay_;
   OptionsTable table_;  ///< Rows point into options_ and overlay_: the command is not copied.

@@ -16,7 +16,8 @@ const CLI::Validator kNotEmpty(
     [](std::string& value) { return value.empty() ? std::string("must not be empty") : ""; }, "");
 
 void printSummary(const std::string& image_path, const std::string& out_dir,
-                  const PlanarSceneOptions& options, const PlanarScene& scene) {
+                  const PlanarSceneOptions& options, const PlanarScene& scene,
+                  bool with_initial_poses) {
   const double distance = std::hypot(options.orbit_radius, options.camera_height);
   std::printf("synth planar: %zu frames of %dx%d px (fx %g, fy %g, cx %g, cy %g), 1/30 s apart\n",
               scene.images.size(), options.width, options.height, options.fx, options.fy,
@@ -31,16 +32,18 @@ void printSummary(const std::string& image_path, const std::string& out_dir,
               1e3 * scene.firstToLastBaseline());
   std::printf("noise: intensity std dev %.2f levels (%g x 255) per pixel and channel, seed %u\n",
               options.intensity_noise * 255.0, options.intensity_noise, options.seed);
-  std::printf("initial poses: %s, std dev %g m and %g deg per axis %s\n",
-              options.init_noise_model == InitNoiseModel::kDrift
-                  ? "drift (every motion between frames perturbed)"
-                  : "every frame perturbed on its own",
-              options.init_noise_translation, options.init_noise_rotation_deg,
-              options.init_noise_model == InitNoiseModel::kDrift ? "per step" : "per pose");
-  std::printf(
-      "written: %s (rgb.txt, rgb/ with %zu PNG, camera.yaml, groundtruth.txt, "
-      "init_poses.txt)\n",
-      out_dir.c_str(), scene.images.size());
+  if (with_initial_poses) {
+    std::printf("initial poses: %s, std dev %g m and %g deg per axis %s\n",
+                options.init_noise_model == InitNoiseModel::kDrift
+                    ? "drift (every motion between frames perturbed)"
+                    : "every frame perturbed on its own",
+                options.init_noise_translation, options.init_noise_rotation_deg,
+                options.init_noise_model == InitNoiseModel::kDrift ? "per step" : "per pose");
+  } else {
+    std::printf("initial poses: none (`run` starts from the point initialiser)\n");
+  }
+  std::printf("written: %s (rgb.txt, rgb/ with %zu PNG, camera.yaml, groundtruth.txt%s)\n",
+              out_dir.c_str(), scene.images.size(), with_initial_poses ? ", init_poses.txt" : "");
 }
 
 }  // namespace
@@ -64,6 +67,10 @@ SynthCommand::SynthCommand(CLI::App* app) {
   c->add_option("--out", out_dir_, "Dataset folder to write (created if needed)")
       ->required()
       ->check(kNotEmpty);
+  c->add_option("--init-poses", write_init_poses_,
+                "Write init_poses.txt, the perturbed truth; false leaves `run` to the point "
+                "initialiser")
+      ->capture_default_str();
   addPlanarSceneOptions(&table_, &options_, {"", "", "Scene", ""});
   table_.addFlags(c);
 }
@@ -85,8 +92,8 @@ int SynthCommand::run() const {
   options.validate();
   const cv::Mat photo = readColorImage(image_path_);
   const PlanarScene scene = makePlanarScene(photo, options);
-  writePlanarDataset(out_dir_, scene);
-  printSummary(image_path_, out_dir_, options, scene);
+  writePlanarDataset(out_dir_, scene, write_init_poses_);
+  printSummary(image_path_, out_dir_, options, scene, write_init_poses_);
   return 0;
 }
 

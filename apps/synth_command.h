@@ -34,6 +34,7 @@ class SynthCommand {
   OptionsTable table_;  ///< Rows point into options_: the command is not copied.
   std::string image_path_;
   std::string out_dir_;
+  bool write_init_poses_ = true;
 };
 
 }  // namespace curvesfm

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "core/colmap_model.h"
 #include "core/errors.h"
 #include "core/image_sequence.h"
 #include "core/timestamp_association.h"
@@ -36,34 +37,6 @@ std::string timeSpan(const std::vector<double>& times) {
   return text;
 }
 
-std::vector<DatasetFrame> matchFrames(const std::vector<ImageEntry>& images,
-                                      const std::vector<StampedPose>& poses, double max_dt,
-                                      const TumDataset& d) {
-  std::vector<StampedPose> image_times(images.size());
-  std::vector<double> image_stamps, pose_stamps;
-  for (std::size_t i = 0; i < images.size(); ++i) {
-    image_times[i].timestamp = images[i].timestamp;
-    image_stamps.push_back(images[i].timestamp);
-  }
-  for (const StampedPose& pose : poses) pose_stamps.push_back(pose.timestamp);
-  std::vector<DatasetFrame> frames;
-  for (const TimestampMatch& m : associateByTimestamp(image_times, poses, max_dt)) {
-    const ImageEntry& image = images[m.estimate_index];
-    frames.push_back(
-        {image.timestamp, image.path, poses[m.ground_truth_index].world_from_cam.inverse()});
-  }
-  if (frames.empty()) {
-    char within[32];
-    std::snprintf(within, sizeof(within), "%g", max_dt);
-    throw ParseError(
-        d.init_poses_path, 0,
-        "poses within " + std::string(within) + " s of the images of " + d.rgb_path + " (" +
-            timeSpan(image_stamps) + ")",
-        "none of its " + std::to_string(poses.size()) + " poses (" + timeSpan(pose_stamps) + ")");
-  }
-  return frames;
-}
-
 }  // namespace
 
 // The TUM reader of loadImageSequence() reads camera.yaml, rgb.txt and groundtruth.txt and checks
@@ -77,16 +50,55 @@ TumDataset loadTumDataset(const std::string& dir, const std::string& init_poses_
   options.layout = DatasetLayout::kTum;
   const ImageSequence sequence = loadImageSequence(dir, options);
   d.camera.emplace(sequence.camera);
-  std::vector<ImageEntry> images;
-  for (const SequenceImage& image : sequence.images) {
-    images.push_back({image.timestamp, image.image_path});
-  }
-  d.images = static_cast<int>(images.size());
+  d.images = static_cast<int>(sequence.images.size());
   d.init_poses_path = initPosesPath(dir, init_poses_flag);
-  d.frames = matchFrames(images, readTrajectory(d.init_poses_path), max_dt, d);
+  d.frames =
+      framesWithPoses(sequence, readTrajectory(d.init_poses_path), max_dt, d.init_poses_path);
   d.ground_truth_path = sequence.ground_truth_source;
   d.ground_truth = sequence.ground_truth;
   return d;
+}
+
+std::vector<DatasetFrame> framesWithPoses(const ImageSequence& sequence,
+                                          const std::vector<StampedPose>& poses, double max_dt,
+                                          const std::string& poses_source) {
+  std::vector<StampedPose> image_times(sequence.images.size());
+  std::vector<double> image_stamps, pose_stamps;
+  for (std::size_t i = 0; i < sequence.images.size(); ++i) {
+    image_times[i].timestamp = sequence.images[i].timestamp;
+    image_stamps.push_back(sequence.images[i].timestamp);
+  }
+  for (const StampedPose& pose : poses) pose_stamps.push_back(pose.timestamp);
+  std::vector<DatasetFrame> frames;
+  for (const TimestampMatch& m : associateByTimestamp(image_times, poses, max_dt)) {
+    const SequenceImage& image = sequence.images[m.estimate_index];
+    frames.push_back(
+        {image.timestamp, image.image_path, poses[m.ground_truth_index].world_from_cam.inverse()});
+  }
+  if (frames.empty()) {
+    char within[32];
+    std::snprintf(within, sizeof(within), "%g", max_dt);
+    throw ParseError(
+        poses_source, 0,
+        "poses within " + std::string(within) + " s of the images of " + sequence.dir + " (" +
+            timeSpan(image_stamps) + ")",
+        "none of its " + std::to_string(poses.size()) + " poses (" + timeSpan(pose_stamps) + ")");
+  }
+  return frames;
+}
+
+std::vector<StampedPose> readInitialPoses(const std::string& path, const ImageSequence& sequence,
+                                          std::string* source) {
+  source->clear();
+  std::string file = path;
+  if (file.empty()) {
+    const std::string fallback = joinPath(sequence.dir, "init_poses.txt");
+    if (!fs::exists(fallback)) return {};
+    file = fallback;
+  }
+  *source = file;
+  if (fs::is_directory(file)) return colmapPosesForSequence(readColmapModel(file), sequence);
+  return readTrajectory(file);
 }
 
 cv::Mat loadFrameImage(const DatasetFrame& frame, const Camera& camera) {

@@ -7,6 +7,7 @@
 
 #include "core/camera.h"
 #include "core/dataset_io.h"
+#include "core/image_sequence.h"
 
 namespace curvesfm {
 
@@ -40,6 +41,21 @@ struct TumDataset {
 /// naming the file.
 TumDataset loadTumDataset(const std::string& dir, const std::string& init_poses_path,
                           double max_dt);
+
+/// The images of `sequence` that have an initial pose in `poses` (camera-to-world), each taking
+/// the pose nearest in time within `max_dt` seconds (associateByTimestamp), in the sequence's
+/// order. ParseError naming `poses_source` when no image has one.
+std::vector<DatasetFrame> framesWithPoses(const ImageSequence& sequence,
+                                          const std::vector<StampedPose>& poses, double max_dt,
+                                          const std::string& poses_source);
+
+/// The initial poses `run` starts from, camera-to-world, and where they came from (`*source`):
+/// `path` names a TUM trajectory file or a COLMAP model folder (text or binary; its poses are
+/// matched to the images by name and stamped with their timestamps); an empty `path` takes
+/// DIR/init_poses.txt when the dataset has one. Empty (and `*source` empty) when there are none:
+/// the initialiser must find them. IoError or ParseError naming the file for bad input.
+std::vector<StampedPose> readInitialPoses(const std::string& path, const ImageSequence& sequence,
+                                          std::string* source);
 
 /// Decodes `frame`'s image (8-bit BGR); IoError naming it if it does not load or its size differs
 /// from `camera`'s.

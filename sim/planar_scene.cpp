@@ -258,7 +258,7 @@ PlanarScene makePlanarScene(const cv::Mat& texture_bgr, const PlanarSceneOptions
   return scene;
 }
 
-void writePlanarDataset(const std::string& dir, const PlanarScene& scene) {
+void writePlanarDataset(const std::string& dir, const PlanarScene& scene, bool with_initial_poses) {
   const std::size_t frames = scene.timestamps.size();
   CURVESFM_CHECK(scene.camera && scene.images.size() == frames &&
                  scene.true_cam_from_world.size() == frames &&
@@ -277,7 +277,13 @@ void writePlanarDataset(const std::string& dir, const PlanarScene& scene) {
   writeCameraYaml((root / "camera.yaml").string(), *scene.camera);
   writeTrajectory((root / "groundtruth.txt").string(),
                   stampedPoses(scene.timestamps, scene.true_cam_from_world));
-  writeTrajectory((root / "init_poses.txt").string(),
+  const std::filesystem::path init_poses = root / "init_poses.txt";
+  if (!with_initial_poses) {
+    std::error_code ignored;  // A missing file is what we want.
+    std::filesystem::remove(init_poses, ignored);
+    return;
+  }
+  writeTrajectory(init_poses.string(),
                   stampedPoses(scene.timestamps, scene.initial_cam_from_world));
 }
 

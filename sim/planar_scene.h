@@ -179,9 +179,11 @@ PlanarScene makePlanarScene(const cv::Mat& texture_bgr, const PlanarSceneOptions
 
 /// Writes the scene as a dataset in DESIGN.md's TUM RGB-D layout: `dir`/rgb.txt, rgb/NNNNNN.png
 /// (lossless, frame index with 6 digits), camera.yaml, groundtruth.txt (true poses) and
-/// init_poses.txt (initial poses), trajectories camera-to-world. Creates `dir` and rgb/ if
-/// needed; existing files of the same names are overwritten, others left alone. Throws IoError
-/// naming the path that cannot be created or written.
-void writePlanarDataset(const std::string& dir, const PlanarScene& scene);
+/// init_poses.txt (initial poses; without `with_initial_poses`, none, and an older one is
+/// removed so that `run` starts from the point initialiser), trajectories camera-to-world.
+/// Creates `dir` and rgb/ if needed; existing files of the same names are overwritten, others
+/// left alone. Throws IoError naming the path that cannot be created or written.
+void writePlanarDataset(const std::string& dir, const PlanarScene& scene,
+                        bool with_initial_poses = true);
 
 }  // namespace curvesfm

@@ -661,7 +661,9 @@ struct PointInitialiser::State {
       }
       const bool elsewhere = std::any_of(models.begin(), models.end(),
                                          [f](const Model& m) { return m.poses[f].has_value(); });
-      if (elsewhere) {
+      if (models.empty()) {
+        frame.status = FrameRegistration::kNoModel;
+      } else if (elsewhere) {
         frame.status = FrameRegistration::kUnmergedModel;
       } else if (frame.status == FrameRegistration::kNotTried && !tracks.frame_tracks[f].empty()) {
         frame.status = FrameRegistration::kNoCorrespondences;

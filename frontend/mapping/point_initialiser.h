@@ -114,16 +114,18 @@ enum class FrameRegistration {
   kNoCorrespondences,  ///< No model point is seen in it (tracks lost).
   kRejected,           ///< PnP tried and rejected it (see the rejection).
   kNotTried,           ///< The models stopped before this frame came up (too many failures).
+  kNoModel,            ///< No model could be started at all (no initial pair; see the failure).
   kUnmergedModel,      ///< Registered in a sub-model that could not be merged with the first.
 };
 
 template <>
 struct EnumNames<FrameRegistration> {
-  static constexpr std::array<std::pair<FrameRegistration, const char*>, 5> kNames = {
+  static constexpr std::array<std::pair<FrameRegistration, const char*>, 6> kNames = {
       {{FrameRegistration::kRegistered, "registered"},
        {FrameRegistration::kNoCorrespondences, "no_correspondences"},
        {FrameRegistration::kRejected, "rejected"},
        {FrameRegistration::kNotTried, "not_tried"},
+       {FrameRegistration::kNoModel, "no_model"},
        {FrameRegistration::kUnmergedModel, "unmerged_model"}}};
 };
 

@@ -29,10 +29,18 @@ using testing::ringsTexture;
 using testing::RunCommandTest;
 using testing::runCurvesfm;
 
-TEST_F(RunCommandTest, MissingRgbListNamesTheFile) {
+TEST_F(RunCommandTest, AFolderInNoKnownLayoutSaysWhatWasLookedFor) {
   writeTinyDataset();
   std::filesystem::remove(path("rgb.txt"));
-  expectOneLineError(run(), "IoError: " + path("rgb.txt") + ": cannot open for reading");
+  const CommandResult result = run();
+  expectOneLineError(result, "IoError: " + folder_.string() + ": no known dataset layout");
+  EXPECT_THAT(result.output, HasSubstr("rgb.txt (tum)"));
+}
+
+TEST_F(RunCommandTest, ATumFolderWithoutItsImageListNamesIt) {
+  writeTinyDataset();
+  std::filesystem::remove(path("rgb.txt"));
+  expectOneLineError(run("--layout tum"), "IoError: " + path("rgb.txt") + ": cannot open");
 }
 
 TEST_F(RunCommandTest, ImageThatDoesNotLoadNamesTheFile) {
@@ -68,17 +76,20 @@ TEST_F(RunCommandTest, InitialPosesThatMatchNoImageNameBothFiles) {
   std::ofstream(path("poses.txt")) << "50.0 0 0 0 0 0 0 1\n50.1 0 0 0 0 0 0 1\n";
   const CommandResult result = run("--init-poses " + path("poses.txt"));
   expectOneLineError(result, "ParseError: " + path("poses.txt") + ": expected poses within 0.02 s");
-  EXPECT_THAT(result.output, HasSubstr(path("rgb.txt")));
+  EXPECT_THAT(result.output, HasSubstr("images of " + folder_.string()));
   EXPECT_THAT(result.output, HasSubstr("none of its 2 poses"));
 }
 
-TEST_F(RunCommandTest, NoInitialPosesSaysHowToPassThem) {
-  writeTinyDataset();
+TEST_F(RunCommandTest, WithoutInitialPosesTheInitialiserRunsAndSaysWhyItFoundNone) {
+  writeTinyDataset();  // Three flat 8x8 images: no texture, no tracks.
   std::filesystem::remove(path("init_poses.txt"));
   const CommandResult result = run();
-  expectOneLineError(result, "IoError: " + path("init_poses.txt") + ": no such file");
-  EXPECT_THAT(result.output, HasSubstr("automatic initialiser is not available yet"));
-  EXPECT_THAT(result.output, HasSubstr("--init-poses FILE"));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("running the point initialiser on the 3 images first"));
+  EXPECT_THAT(result.output, HasSubstr("init: 0 of 3 frames registered"));
+  EXPECT_THAT(result.output, HasSubstr("run: the initialiser registered 0 frames: nothing to "
+                                       "refine (no initial pair"));
+  EXPECT_FALSE(std::filesystem::exists(path("out")));
 }
 
 TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {

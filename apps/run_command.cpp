@@ -359,6 +359,7 @@ int RunCommand::run() const {
                    {"images", d.images},
                    {"frames_with_initial_pose", d.frames.size()}}},
                  {"camera", cameraToJson(pipeline.undistortedCamera())},
+                 {"scene_scale", result.scene_scale},
                  {"counts",
                   {{"frames", d.frames.size()},
                    {"keyframes", result.keyframe_cam_from_world.size()},

@@ -680,7 +680,13 @@ PipelineResult Pipeline::finish() {
   result.scene_scale = impl.scene_scale;
   for (const Keyframe& keyframe : impl.keyframes) {
     result.keyframe_timestamps.push_back(keyframe.timestamp);
-    result.keyframe_cam_from_world.push_back(scaledPose(keyframe.cam_from_world, unit));
+    // A pose nothing moved is returned exactly as given, without the grid's rounding.
+    const bool moved =
+        keyframe.cam_from_world.translation() != keyframe.initial_cam_from_world.translation() ||
+        keyframe.cam_from_world.rotation().coeffs() !=
+            keyframe.initial_cam_from_world.rotation().coeffs();
+    result.keyframe_cam_from_world.push_back(moved ? scaledPose(keyframe.cam_from_world, unit)
+                                                   : keyframe.given_cam_from_world);
     result.keyframe_initial_cam_from_world.push_back(keyframe.given_cam_from_world);
   }
   for (const PolyBezier& curve : impl.map.exportCurves(CurveSelection::kPromoted).curves) {

@@ -419,6 +419,7 @@ int RunCommand::run() const {
        {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
                                             : nlohmann::json(nullptr)},
        {"camera", cameraToJson(pipeline.undistortedCamera())},
+       {"scene_scale", result.scene_scale},
        {"counts",
         {{"frames", input.frames.size()},
          {"keyframes", result.keyframe_cam_from_world.size()},

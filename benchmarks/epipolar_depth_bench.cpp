@@ -49,9 +49,9 @@ constexpr double kFocal = 525.0;          // px, CameraIntrinsics' default.
 struct BenchOptions {
   int repeats = 7;  ///< Timed runs per case (median reported); >= 1.
   std::string photo = "/usr/share/doc/opencv-doc/examples/data/building.jpg";  ///< Texture.
-  unsigned seed = 1;         ///< Seed of the synthetic texture.
-  double min_depth_m = 0.5;  ///< EpipolarDepthOptions::min_depth_m (m); the plane is at ~1.5 m.
-  double max_depth_m = 5.0;  ///< EpipolarDepthOptions::max_depth_m (m); > min_depth_m.
+  unsigned seed = 1;       ///< Seed of the synthetic texture.
+  double min_depth = 0.5;  ///< EpipolarDepthOptions::min_depth (m); the plane is at ~1.5 m.
+  double max_depth = 5.0;  ///< EpipolarDepthOptions::max_depth (m); > min_depth.
 };
 
 double millisecondsSince(Clock::time_point start) { return 1e3 * bench::secondsSince(start); }
@@ -136,8 +136,8 @@ double medianRelativeError(const Keyframe& key, const ChainDepths& depths) {
 void runCase(const Keyframe& key, int pixel_step, const std::string& name,
              const BenchOptions& bench) {
   EpipolarDepthOptions options;
-  options.min_depth_m = bench.min_depth_m;
-  options.max_depth_m = bench.max_depth_m;
+  options.min_depth = bench.min_depth;
+  options.max_depth = bench.max_depth;
   options.pixel_step = pixel_step;
   if (pixel_step > 1) options.min_window_support = 2;
   std::vector<double> wall_ms;
@@ -172,8 +172,8 @@ int run(const BenchOptions& bench) {
       "# epipolar_depth_bench: estimateChainDepths per 640x480 keyframe, two references, one "
       "thread; medians of %d repeats\n",
       bench.repeats);
-  print("min_depth_m", bench.min_depth_m);
-  print("max_depth_m", bench.max_depth_m);
+  print("min_depth", bench.min_depth);
+  print("max_depth", bench.max_depth);
   std::vector<std::pair<std::string, cv::Mat>> textures = {{"blobs", blobTexture(bench.seed)}};
   const cv::Mat photo = cv::imread(bench.photo, cv::IMREAD_GRAYSCALE);
   if (!photo.empty()) textures.emplace_back("photo", photo);
@@ -197,10 +197,10 @@ int main(int argc, char** argv) {
   app.add_option("--photo", bench.photo, "Photograph laid on the plane (skipped if missing)")
       ->capture_default_str();
   app.add_option("--seed", bench.seed, "Seed of the synthetic texture")->capture_default_str();
-  app.add_option("--min-depth", bench.min_depth_m, "Nearest depth searched (m)")
+  app.add_option("--min-depth", bench.min_depth, "Nearest depth searched (m)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--max-depth", bench.max_depth_m, "Farthest depth searched (m)")
+  app.add_option("--max-depth", bench.max_depth, "Farthest depth searched (m)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   return curvesfm::bench::parseAndRun(app, argc, argv, [&] { return curvesfm::run(bench); });

@@ -18,9 +18,11 @@
 namespace curvesfm {
 
 /// The paper's objective E = E_geo + lambda1 E_s1 + lambda2 E_s2 (§3.1) as graph weights.
-/// E_geo residuals are pixels, E_s1 residuals scene length units (metres), E_s2 residuals
-/// radians, so the lambdas carry units: lambda1 is px^2 per m^2 of length change, lambda2 px^2
-/// per rad^2. Each term becomes a noise model with sigma = 1 / sqrt(lambda).
+/// E_geo residuals are pixels, E_s1 residuals scene length units (the unit of the poses and
+/// curves given: metres in curve-ba's scenes, multiples of the scene scale in the pipeline, which
+/// works in that unit; see defaultPipelineBundleAdjustmentOptions()), E_s2 residuals radians, so
+/// the lambdas carry units: lambda1 is px^2 per squared length unit of length change, lambda2
+/// px^2 per rad^2. Each term becomes a noise model with sigma = 1 / sqrt(lambda).
 struct CurveBundleAdjustmentOptions {
   /// s: each (segment, keyframe) pair gives s + 1 residuals at t_k = k / s. 1..64.
   int samples_per_segment = 10;
@@ -34,13 +36,14 @@ struct CurveBundleAdjustmentOptions {
   double pixel_sigma = 1.0;                            ///< Std dev of an edge residual (px); > 0.
   RobustKernelType kernel = RobustKernelType::kHuber;  ///< Kernel on edge residuals.
   double kernel_width = 2.0;  ///< Kernel width in sigmas (px at sigma 1); > 0.
-  double lambda1 = 100.0;     ///< Weight of E_s1, segment length (px^2 / m^2); >= 0, 0 drops it.
+  double lambda1 =
+      100.0;  ///< Weight of E_s1, segment length (px^2 / length unit^2); >= 0, 0 drops it.
   double lambda2 = 1.0;  ///< Weight of E_s2, tangent alignment (px^2 / rad^2); >= 0, 0 drops it.
   bool fix_first_pose = true;  ///< Hold keyframe 0 constant (6 of the 7 gauge DoF).
   /// Fix the scale through the distance between keyframes 0 and 1 (a CameraDistanceFactor at
   /// CurveBundleAdjustmentInput::scale_distance). Needs at least 2 keyframes.
   bool fix_scale = true;
-  double scale_sigma = 1e-4;  ///< Std dev of that distance constraint (scene units); > 0.
+  double scale_sigma = 1e-4;  ///< Std dev of that distance constraint (length unit); > 0.
   /// Tie the motion between consecutive keyframes to that of
   /// CurveBundleAdjustmentInput::motion_prior_cam_from_world (a RelativePoseFactor per pair):
   /// odometry drifts but is locally accurate, and it holds the pose directions that a scene

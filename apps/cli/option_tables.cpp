@@ -76,9 +76,9 @@ void addImageStages(OptionsTable* table, PipelineOptions* o, const std::string& 
 void addDepth(OptionsTable* table, EpipolarDepthOptions* d, const std::string& path) {
   const OptionPlace p = stage(path, "depth", "depth-", "Depth");
   table->group(d, "EpipolarDepthOptions", p.path, p.prefix, p.heading)
-      .number("min_depth_m", "min", &d->min_depth_m, "Nearest depth searched (m)")
-      .number("max_depth_m", "max", &d->max_depth_m,
-              "Farthest depth searched (m); inf searches to the vanishing point")
+      .number("min_depth", "min", &d->min_depth, "Nearest depth searched (scene scales)")
+      .number("max_depth", "max", &d->max_depth,
+              "Farthest depth searched (scene scales); inf searches to the vanishing point")
       .number("min_parallax_deg", "min-parallax", &d->min_parallax_deg,
               "Least parallax of a reference frame at the mid-range depth (deg)")
       .number("max_optical_axis_angle_deg", "max-axis-angle", &d->max_optical_axis_angle_deg,
@@ -128,8 +128,8 @@ void addCurveStages(OptionsTable* table, PipelineOptions* o, const std::string& 
               "A run ends at a relative depth jump above this")
       .number("max_rms_residual_rel_chord", "max-rms-residual", &i->max_rms_residual_rel_chord,
               "Reject a segment whose RMS fit residual exceeds this fraction of its chord")
-      .number("min_chord_m", "min-chord", &i->min_chord_m,
-              "Reject segments with a shorter chord (m)")
+      .number("min_chord", "min-chord", &i->min_chord,
+              "Reject segments with a shorter chord (scene scales)")
       .number("max_arm_to_chord", "max-arm-to-chord", &i->max_arm_to_chord,
               "Reject a segment whose arm exceeds this multiple of its chord");
   CurveExtensionOptions* x = &o->extension;
@@ -150,8 +150,8 @@ void addCurveStages(OptionsTable* table, PipelineOptions* o, const std::string& 
   table->group(c, "CorrespondenceOptions", m.path, m.prefix, m.heading)
       .number("samples_per_segment", "samples-per-segment", &c->samples_per_segment,
               "Samples per segment of the checks")
-      .number("min_depth_m", "min-depth", &c->min_depth_m,
-              "Least depth of every sample in the new camera (m)")
+      .number("min_depth", "min-depth", &c->min_depth,
+              "Least depth of every sample in the new camera (scene scales)")
       .number("max_mean_edge_distance_px", "max-edge-distance", &c->max_mean_edge_distance_px,
               "Largest mean distance to the nearest edge (px)")
       .number("appearance_half_width_px", "appearance-half-width", &c->appearance_half_width_px,
@@ -172,7 +172,7 @@ void addCurveStages(OptionsTable* table, PipelineOptions* o, const std::string& 
       .number("disable_unseen_fraction", "disable-unseen-fraction", &map->disable_unseen_fraction,
               "Disable a curve when more of its segments than this went unseen in the window")
       .number("min_keyframe_translation", "keyframe-translation", &map->min_keyframe_translation,
-              "New keyframe when the initial camera centre moved more than this (pose units)")
+              "New keyframe when the initial camera centre moved more than this (scene scales)")
       .number("min_keyframe_rotation_deg", "keyframe-rotation", &map->min_keyframe_rotation_deg,
               "... or turned more than this (deg)");
 }
@@ -246,7 +246,8 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
       .enumeration("kernel", "kernel", &b->kernel, "Robust kernel on edge residuals")
       .number("kernel_width", "kernel-width", &b->kernel_width, "Kernel width (sigmas)")
       .number("lambda1", "lambda1", &b->lambda1,
-              "Weight of the segment-length term (px^2/m^2); 0 drops it")
+              "Weight of the segment-length term (px^2 per squared length unit: scene scale in "
+              "run, scene unit in curve-ba); 0 drops it")
       .number("lambda2", "lambda2", &b->lambda2,
               "Weight of the tangent term (px^2/rad^2); 0 drops it")
       .boolean("fix_first_pose", "fix-first-pose", &b->fix_first_pose,
@@ -254,7 +255,7 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
       .boolean("fix_scale", "fix-scale", &b->fix_scale,
                "Hold the distance between keyframes 0 and 1 (scale gauge)")
       .number("scale_sigma", "scale-sigma", &b->scale_sigma,
-              "Std dev of that distance constraint (pose units)")
+              "Std dev of that distance constraint (length unit: scene scales in run)")
       .boolean("motion_prior", "motion-prior", &b->motion_prior,
                "Tie the motion between consecutive keyframes to the initial poses'")
       .number("motion_prior_rotation_sigma_deg", "motion-prior-rotation",
@@ -282,6 +283,9 @@ void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentO
 
 void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::string& path) {
   table->group(o, "PipelineOptions", path, "", "Pipeline")
+      .number("scene_scale", "scene-scale", &o->scene_scale,
+              "Unit of every length option (pose units); 0 = the distance between the first two "
+              "distinct initial camera centres")
       .nested("undistort")
       .nested("edges")
       .nested("chains")

@@ -175,8 +175,8 @@ void CorrespondenceOptions::validate() const {
   const OptionCheck require("CorrespondenceOptions");
   require(samples_per_segment >= 2 && samples_per_segment <= kMaxSamples, "samples_per_segment",
           samples_per_segment, "in [2, 65]");
-  require(std::isfinite(min_depth_m) && min_depth_m >= Camera::kMinDepth, "min_depth_m",
-          min_depth_m, "must be finite and >= Camera::kMinDepth (1e-6)");
+  require(std::isfinite(min_depth) && min_depth >= Camera::kMinDepth, "min_depth", min_depth,
+          "must be finite and >= Camera::kMinDepth (1e-6)");
   require(std::isfinite(max_mean_edge_distance_px) && max_mean_edge_distance_px > 0.0,
           "max_mean_edge_distance_px", max_mean_edge_distance_px, "must be finite and > 0");
   require(appearance_half_width_px >= 0 && appearance_half_width_px <= kMaxHalfWidth,
@@ -199,7 +199,7 @@ CheckResult checkPositiveDepth(const BezierSegmentParams& segment, const Pose3& 
     min_depth = std::min(min_depth, projector.sample(t).point_in_cam.z());
   }
   // Written as a positive comparison so that a NaN depth fails.
-  return {min_depth >= options.min_depth_m, min_depth};
+  return {min_depth >= options.min_depth, min_depth};
 }
 
 CheckResult checkEdgeDistance(const BezierSegmentParams& segment, const Pose3& cam_from_world,
@@ -310,7 +310,7 @@ CorrespondenceVerdict registerSegment(const BezierSegmentParams& segment, const 
   };
 
   const CheckResult depth = checkPositiveDepth(segment, view.cam_from_world, options);
-  verdict.min_depth_m = depth.value;
+  verdict.min_depth = depth.value;
   if (!depth.passed) return fail(CorrespondenceCheck::kDepth);
 
   const CheckResult distance =

@@ -25,9 +25,11 @@ struct CorrespondenceOptions {
   /// Samples B(t_k), t_k = k / (m - 1), k = 0..m-1, taken along the segment by the depth, edge
   /// distance and appearance checks (count). In [2, 65].
   int samples_per_segment = 10;
-  /// Minimum depth z of every sample in the new camera (m, along the principal axis). Finite and
-  /// >= Camera::kMinDepth; the default only keeps projections finite, it is no near plane.
-  double min_depth_m = 0.01;
+  /// Minimum depth z of every sample in the new camera (length unit of the poses, along the
+  /// principal axis; the pipeline's is in multiples of its scene scale, see
+  /// defaultPipelineCorrespondenceOptions()). Finite and >= Camera::kMinDepth; the default only
+  /// keeps projections finite, it is no near plane.
+  double min_depth = 0.01;
   /// Largest accepted mean distance between the projected samples and their nearest edge pixel
   /// (px; see checkEdgeDistance). A sample outside the image or beyond the field's reach counts as
   /// the reach. Finite, > 0.
@@ -76,8 +78,8 @@ struct CheckResult {
   double value = 0.0;  ///< Unit given by the function that returned it.
 };
 
-/// Depth check: every sample has depth z >= options.min_depth_m in cam_from_world.
-/// value: the smallest sample depth (m; negative behind the camera).
+/// Depth check: every sample has depth z >= options.min_depth in cam_from_world.
+/// value: the smallest sample depth (length unit of the poses; negative behind the camera).
 CheckResult checkPositiveDepth(const BezierSegmentParams& segment, const Pose3& cam_from_world,
                                const CorrespondenceOptions& options);
 
@@ -184,7 +186,7 @@ struct CorrespondenceVerdict {
   bool registered = false;
   /// The first check that failed; kNone if registered.
   CorrespondenceCheck failed_check = CorrespondenceCheck::kNone;
-  double min_depth_m = kNotRun;            ///< checkPositiveDepth's value (m).
+  double min_depth = kNotRun;              ///< checkPositiveDepth's value (pose units).
   double mean_edge_distance_px = kNotRun;  ///< checkEdgeDistance's value (px).
   double viewing_angle_deg = kNotRun;      ///< checkViewingDirection's value (deg).
   double appearance_error = kNotRun;       ///< checkAppearance's value (unitless).

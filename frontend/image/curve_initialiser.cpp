@@ -125,7 +125,7 @@ bool accept(const CubicBezier& cubic, const Eigen::Vector3d* points, int m,
   const Eigen::Vector3d chord = cubic.control[3] - cubic.control[0];
   const double length = chord.norm();
   int* rejected_by = nullptr;
-  if (!(length >= options.min_chord_m) || length == 0.0) {
+  if (!(length >= options.min_chord) || length == 0.0) {
     rejected_by = &counts->segments_short_chord;
   } else if (isLoop(cubic, chord, options.max_arm_to_chord)) {
     rejected_by = &counts->segments_loop;
@@ -190,7 +190,7 @@ void CurveInitialiserOptions::validate() const {
        inOpenClosed(max_relative_depth_jump, 0.0, 100.0), "in (0, 100]"},
       {"max_rms_residual_rel_chord", max_rms_residual_rel_chord,
        inOpenClosed(max_rms_residual_rel_chord, 0.0, 100.0), "in (0, 100]"},
-      {"min_chord_m", min_chord_m, inClosed(min_chord_m, 0.0, 1e6), "in [0, 1e6]"},
+      {"min_chord", min_chord, inClosed(min_chord, 0.0, 1e6), "in [0, 1e6]"},
       {"max_arm_to_chord", max_arm_to_chord, inOpenClosed(max_arm_to_chord, 0.0, 100.0),
        "in (0, 100]"},
   };

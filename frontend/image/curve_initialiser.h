@@ -13,8 +13,9 @@ namespace curvesfm {
 /// How CurveInitialiser turns a keyframe's chains with depth into poly-Bézier curves (paper §2.3,
 /// DESIGN.md "The curve model").
 ///
-/// Lengths are in the world's unit (metres for the defaults); a monocular map has an arbitrary
-/// scale, so min_chord_m is meant as a guard against collapsed segments, not as a size filter.
+/// Lengths are in the world's unit (metres for the defaults); the pipeline works in multiples of
+/// its scene scale instead (PipelineOptions::scene_scale, defaultPipelineInitialiserOptions()).
+/// min_chord is meant as a guard against collapsed segments, not as a size filter.
 struct CurveInitialiserOptions {
   int pixels_per_segment = 12;  ///< Target lifted pixels per segment (chain pixels; the paper's
                                 ///< "roughly the same number of pixels"): a run of n points gets
@@ -35,8 +36,8 @@ struct CurveInitialiserOptions {
                                             ///< on integer pixels give 3-5% at 12 px (mostly
                                             ///< the uniform t_k against 1 and 1.41 px steps)
                                             ///< (unitless). In (0, 100].
-  double min_chord_m = 1e-4;      ///< Segments with a shorter chord |P3 - P0| are rejected: their
-                                  ///< tangents are undefined (world length unit, m). In [0, 1e6].
+  double min_chord = 1e-4;        ///< Segments with a shorter chord |P3 - P0| are rejected: their
+                                  ///< tangents are undefined (world length unit). In [0, 1e6].
   double max_arm_to_chord = 1.5;  ///< A segment is rejected as a loop or cusp if an arm
                                   ///< |P1 - P0| or |P3 - P2| is longer than this multiple of its
                                   ///< chord, or points against it; a circular arc of angle a has
@@ -73,7 +74,7 @@ struct CurveInitialisationCounts {
   int runs = 0;                     ///< Runs of >= 4 lifted pixels, split into segments.
   int runs_too_short = 0;           ///< Runs of 1-3 lifted pixels, dropped: a cubic needs 4.
   int segments_accepted = 0;        ///< Fitted segments kept (before the min_segments filter).
-  int segments_short_chord = 0;     ///< Rejected by min_chord_m.
+  int segments_short_chord = 0;     ///< Rejected by min_chord.
   int segments_loop = 0;            ///< Rejected by max_arm_to_chord.
   int segments_bad_fit = 0;         ///< Rejected by max_rms_residual_rel_chord.
   int curves = 0;                   ///< Curves returned.

@@ -44,7 +44,7 @@ bool inClosed(double value, double low, double high) { return value >= low && va
 bool inOpenClosed(double value, double low, double high) { return value > low && value <= high; }
 
 double midInverseDepth(const EpipolarDepthOptions& options) {
-  return 0.5 * (1.0 / options.min_depth_m + 1.0 / options.max_depth_m);
+  return 0.5 * (1.0 / options.min_depth + 1.0 / options.max_depth);
 }
 
 double minGradientCosine(const EpipolarDepthOptions& options) {
@@ -74,8 +74,8 @@ ReferenceGeometry referenceGeometry(int index, const Pose3& key_cam_from_world,
   ReferenceCandidate& candidate = geometry.candidate;
   candidate.index = index;
   // The keyframe's centre in the reference frame is t, so |t| is the baseline.
-  candidate.baseline_m = ref_from_key.translation().norm();
-  candidate.parallax_deg = std::atan(candidate.baseline_m * midInverseDepth(options)) / kRadPerDeg;
+  candidate.baseline = ref_from_key.translation().norm();
+  candidate.parallax_deg = std::atan(candidate.baseline * midInverseDepth(options)) / kRadPerDeg;
   candidate.optical_axis_angle_deg = std::acos(std::clamp(R(2, 2), -1.0, 1.0)) / kRadPerDeg;
   candidate.eligible = candidate.parallax_deg >= options.min_parallax_deg &&
                        candidate.optical_axis_angle_deg <= options.max_optical_axis_angle_deg;
@@ -154,14 +154,14 @@ struct EpipolarSegment {
   double score = 0.0;      // Cross-edge parallax at the mid-range depth (px).
 };
 
-// The whole segment of [1 / max_depth_m, 1 / min_depth_m] (clipped to the front of the
+// The whole segment of [1 / max_depth, 1 / min_depth] (clipped to the front of the
 // reference) from x0 (far) to x0 + d (near), and the local affine map J in its middle; false if
 // it lies behind the reference or is a point (the pixel is the epipole).
 bool fullSegment(const ReferenceGeometry& geometry, const Eigen::Vector3d& A,
                  const EpipolarDepthOptions& options, Eigen::Vector2d* x0, Eigen::Vector2d* d,
                  Eigen::Matrix2d* J) {
-  double lo = 1.0 / options.max_depth_m;
-  double hi = 1.0 / options.min_depth_m;
+  double lo = 1.0 / options.max_depth;
+  double hi = 1.0 / options.min_depth;
   if (!clipToFront(A.z(), geometry.b.z(), &lo, &hi)) return false;
   *x0 = projectAt(A, geometry.b, lo);
   *d = projectAt(A, geometry.b, hi) - *x0;
@@ -686,10 +686,9 @@ void checkInputs(const Camera& camera, const std::vector<EdgeChain>& chains,
 
 void EpipolarDepthOptions::validate() const {
   const OptionCheck require("EpipolarDepthOptions");
-  require(std::isfinite(min_depth_m) && min_depth_m > 0.0, "min_depth_m", min_depth_m,
+  require(std::isfinite(min_depth) && min_depth > 0.0, "min_depth", min_depth,
           "must be finite and > 0");
-  require(max_depth_m > min_depth_m, "max_depth_m", max_depth_m,
-          "must be > min_depth_m (may be infinity)");
+  require(max_depth > min_depth, "max_depth", max_depth, "must be > min_depth (may be infinity)");
   require(min_parallax_deg >= 0.0 && min_parallax_deg < 90.0, "min_parallax_deg", min_parallax_deg,
           "in [0, 90)");
   require(inOpenClosed(max_optical_axis_angle_deg, 0.0, 180.0), "max_optical_axis_angle_deg",

@@ -18,16 +18,20 @@ namespace curvesfm {
 /// Depths are z in the keyframe camera (along the principal axis, as Camera::unproject); the
 /// search and all variances work in inverse depth rho = 1 / z, in which the epipolar geometry is
 /// linear and image noise is close to Gaussian.
+///
+/// Lengths are in the unit of the poses given to the functions (metres for these defaults).
+/// The pipeline works in multiples of its scene scale instead (PipelineOptions::scene_scale), so
+/// its defaults differ: defaultPipelineDepthOptions().
 struct EpipolarDepthOptions {
-  /// Nearest depth searched (m); finite, > 0.
-  double min_depth_m = 0.2;
-  /// Farthest depth searched (m); > min_depth_m, may be +infinity (the search then reaches the
-  /// vanishing point of the pixel's ray).
-  double max_depth_m = 20.0;
+  /// Nearest depth searched (length unit of the poses); finite, > 0.
+  double min_depth = 0.2;
+  /// Farthest depth searched (length unit of the poses); > min_depth, may be +infinity (the
+  /// search then reaches the vanishing point of the pixel's ray).
+  double max_depth = 20.0;
 
   /// A reference frame is eligible only if its baseline b subtends at least this angle at the
   /// mid-range depth: atan(b * rho_mid) >= min_parallax_deg with
-  /// rho_mid = (1 / min_depth_m + 1 / max_depth_m) / 2 (deg). In [0, 90).
+  /// rho_mid = (1 / min_depth + 1 / max_depth) / 2 (deg). In [0, 90).
   double min_parallax_deg = 0.5;
   /// ... and only if its optical axis is within this angle of the keyframe's (deg): beyond it the
   /// patches change too much between the views. In (0, 180].
@@ -133,7 +137,7 @@ static_assert(EnumNames<DepthStatus>::kNames.size() == kNumDepthStatuses,
 
 /// The depth of one chain pixel.
 struct PixelDepth {
-  /// z of the point in the keyframe camera (m); 0 unless valid.
+  /// z of the point in the keyframe camera (length unit of the poses); 0 unless valid.
   double depth = 0.0;
   /// Variance of the inverse depth (m^-2): the disparity variance, photometric
   /// (4 image_noise_sigma_grey^2 / C'', C'' the curvature of the 1D cost at its minimum) plus
@@ -169,9 +173,9 @@ struct ChainDepths {
 
 /// How well a candidate frame serves as the reference of a keyframe's edge pixels.
 struct ReferenceCandidate {
-  int index = -1;                       ///< Index into the candidate list.
-  double baseline_m = 0.0;              ///< Distance between the camera centres (m).
-  double parallax_deg = 0.0;            ///< atan(baseline * rho_mid) (deg), see min_parallax_deg.
+  int index = -1;             ///< Index into the candidate list.
+  double baseline = 0.0;      ///< Distance between the camera centres (length unit of the poses).
+  double parallax_deg = 0.0;  ///< atan(baseline * rho_mid) (deg), see min_parallax_deg.
   double optical_axis_angle_deg = 0.0;  ///< Angle between the optical axes (deg).
   /// Eligible by min_parallax_deg and max_optical_axis_angle_deg.
   bool eligible = false;
@@ -199,7 +203,7 @@ std::vector<ReferenceCandidate> rankReferenceFrames(
 ///     into the image and the gradient-epipolar angle is small enough; the one with the largest
 ///     cross-edge parallax (ReferenceCandidate::score, evaluated at this pixel) wins.
 ///  2. 1D search: the mean-free SSD of 2h + 1 samples along the keyframe's epipolar line against
-///     the reference's epipolar segment of [min_depth_m, max_depth_m], sampled at the local
+///     the reference's epipolar segment of [min_depth, max_depth], sampled at the local
 ///     scale between the views so that patches correspond.
 ///  3. The max_candidates best local minima (non-maximum suppressed within h samples), each
 ///     refined to sub-pixel by a parabola through its cost and its neighbours'; those whose 1D
@@ -220,7 +224,7 @@ std::vector<ReferenceCandidate> rankReferenceFrames(
 /// `camera` without distortion (ImageUndistorter::camera()); each chain's normals are the unit
 /// image gradients of the keyframe at its pixels (extractEdgeChains). Chain pixels outside the
 /// image are rejected as kAtImageBorder. One thread, no allocation per pixel. The time per
-/// searched pixel grows with its segment, about f * baseline * (1 / min_depth_m - 1 / max_depth_m)
+/// searched pixel grows with its segment, about f * baseline * (1 / min_depth - 1 / max_depth)
 /// px: epipolar_depth_bench measures about 2 us per pixel for 100 px segments (pixel_step halves
 /// the total).
 /// Throws InvalidOptions on bad options, CheckError on bad images, cameras or chains.

@@ -28,9 +28,10 @@ struct CurveMapOptions {
   /// than half".
   double disable_unseen_fraction = 0.5;
   /// A frame becomes a keyframe when its initial camera centre is more than this far from the
-  /// last keyframe's (in the unit of the initial poses, m). >= 0 and finite. The default makes
-  /// every frame of `curvesfm synth planar` (13.5 mm apart) a keyframe. An absolute distance,
-  /// since the initial poses fix the unit the whole pipeline works in.
+  /// last keyframe's, in the length unit KeyframeSelector::isKeyframe is given: the pose unit
+  /// (metres for this default) by default, the scene scale in the pipeline
+  /// (PipelineOptions::scene_scale; its default there is defaultPipelineMapOptions()'s). >= 0
+  /// and finite.
   double min_keyframe_translation = 0.01;
   /// ... or when its initial orientation differs from the last keyframe's by more than this
   /// angle (deg). In [0, 180]. Both thresholds 0 make every frame a keyframe.

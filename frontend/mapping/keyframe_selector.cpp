@@ -17,14 +17,14 @@ KeyframeSelector::KeyframeSelector(const CurveMapOptions& options) : options_(op
   options_.validate();
 }
 
-bool KeyframeSelector::isKeyframe(const Pose3& cam_from_world) {
+bool KeyframeSelector::isKeyframe(const Pose3& cam_from_world, double length_unit) {
   const bool every_frame =
       options_.min_keyframe_translation == 0.0 && options_.min_keyframe_rotation_deg == 0.0;
   bool accept = !has_keyframe_ || every_frame;
   if (!accept) {
-    accept =
-        cameraCentreDistance(cam_from_world, last_keyframe_) > options_.min_keyframe_translation ||
-        rotationAngleDeg(cam_from_world, last_keyframe_) > options_.min_keyframe_rotation_deg;
+    accept = cameraCentreDistance(cam_from_world, last_keyframe_) >
+                 options_.min_keyframe_translation * length_unit ||
+             rotationAngleDeg(cam_from_world, last_keyframe_) > options_.min_keyframe_rotation_deg;
   }
   if (accept) {
     has_keyframe_ = true;

@@ -14,8 +14,9 @@ class KeyframeSelector {
   explicit KeyframeSelector(const CurveMapOptions& options = {});
 
   /// True for the first frame and for every frame that moved or turned enough since the last
-  /// keyframe; a true answer makes `cam_from_world` the new reference.
-  bool isKeyframe(const Pose3& cam_from_world);
+  /// keyframe; a true answer makes `cam_from_world` the new reference. The translation threshold
+  /// is min_keyframe_translation * length_unit (the unit of the poses; length_unit > 0).
+  bool isKeyframe(const Pose3& cam_from_world, double length_unit = 1.0);
 
  private:
   CurveMapOptions options_;

@@ -21,10 +21,11 @@ namespace {
 struct Keyframe {
   int frame_index = 0;
   double timestamp = 0.0;
-  Pose3 initial_cam_from_world;
-  Pose3 cam_from_world;  // Current estimate.
-  cv::Mat image_bgr;     // Undistorted.
-  cv::Mat grey;          // Undistorted.
+  Pose3 given_cam_from_world;    // As given, in pose units (for the result).
+  Pose3 initial_cam_from_world;  // In the scene scale, as every pose below.
+  Pose3 cam_from_world;          // Current estimate.
+  cv::Mat image_bgr;             // Undistorted.
+  cv::Mat grey;                  // Undistorted.
   std::shared_ptr<const NearestEdgeField> field;
 };
 
@@ -118,6 +119,36 @@ int dominantReference(const std::vector<PixelDepth>& depths, const PixelRange& r
   return best;
 }
 
+// `cam_from_world` with the world's lengths multiplied by `factor`.
+Pose3 scaledPose(const Pose3& cam_from_world, double factor) {
+  return Pose3(cam_from_world.rotation(), cam_from_world.translation() * factor);
+}
+
+// `cam_from_world` in pose units moved to the scene scale `scale`, its translation rounded to a
+// grid of 2^-32 scene scales (2.3e-10, far below any pose's accuracy). The same poses given in
+// another unit (millimetres instead of metres) differ from these by rounding in their last bits,
+// and the pipeline amplifies such differences: a projection landing on the other side of a pixel
+// boundary of a nearest-edge field changes a residual, a registration, a curve. On the grid both
+// become the same numbers, so they reconstruct the same scene.
+Pose3 toSceneScale(const Pose3& cam_from_world, double scale) {
+  constexpr double kGrid = 4294967296.0;  // 2^32
+  Eigen::Vector3d t = cam_from_world.translation() / scale;
+  for (int i = 0; i < 3; ++i) t[i] = std::round(t[i] * kGrid) / kGrid;
+  return Pose3(cam_from_world.rotation(), t);
+}
+
+// `curve` with its points and arm lengths multiplied by `factor` (> 0).
+PolyBezier scaledCurve(const PolyBezier& curve, double factor) {
+  std::vector<Eigen::Vector3d> points = curve.points();
+  for (Eigen::Vector3d& p : points) p *= factor;
+  std::vector<SegmentLengths> lengths = curve.lengths();
+  for (SegmentLengths& l : lengths) {
+    l.d1 *= factor;
+    l.d2 *= factor;
+  }
+  return PolyBezier(std::move(points), curve.directions(), std::move(lengths));
+}
+
 void countRejection(CorrespondenceCheck failed, KeyframeStats* stats) {
   switch (failed) {
     case CorrespondenceCheck::kDepth:
@@ -147,6 +178,39 @@ SchedulerOptions defaultLocalBundleAdjustmentOptions() {
   return options;
 }
 
+// The stages' metric defaults in multiples of kPlanarReferenceSceneScale (pipeline.h).
+EpipolarDepthOptions defaultPipelineDepthOptions() {
+  EpipolarDepthOptions options;
+  options.min_depth = 4.6;
+  options.max_depth = 460.0;
+  return options;
+}
+
+CurveInitialiserOptions defaultPipelineInitialiserOptions() {
+  CurveInitialiserOptions options;
+  options.min_chord = 2.3e-3;
+  return options;
+}
+
+CorrespondenceOptions defaultPipelineCorrespondenceOptions() {
+  CorrespondenceOptions options;
+  options.min_depth = 0.23;
+  return options;
+}
+
+CurveMapOptions defaultPipelineMapOptions() {
+  CurveMapOptions options;
+  options.min_keyframe_translation = 0.23;
+  return options;
+}
+
+CurveBundleAdjustmentOptions defaultPipelineBundleAdjustmentOptions() {
+  CurveBundleAdjustmentOptions options;
+  options.lambda1 = 0.19;
+  options.scale_sigma = 2.3e-3;
+  return options;
+}
+
 void PipelineOptions::validate() const {
   undistort.validate();
   edges.validate();
@@ -162,6 +226,8 @@ void PipelineOptions::validate() const {
   global_ba.validate();
   tracking.validate();
   const OptionCheck require("PipelineOptions");
+  require(std::isfinite(scene_scale) && scene_scale >= 0.0, "scene_scale", scene_scale,
+          "must be finite and >= 0 (0 derives it)");
   require(depth_reference_candidates >= 1, "depth_reference_candidates", depth_reference_candidates,
           ">= 1");
   require(reassociation_rounds >= 0, "reassociation_rounds", reassociation_rounds, ">= 0");
@@ -176,7 +242,12 @@ struct Pipeline::Impl {
         camera(std::make_shared<const Camera>(undistorter.camera())),
         initialiser(options.initialiser),
         selector(options.map),
-        map(options.map) {}
+        map(options.map),
+        scene_scale(options.scene_scale) {}
+
+  // The unit the pipeline works in: the scene scale, or the poses' own unit while it is unknown.
+  double unit() const { return scene_scale > 0.0 ? scene_scale : 1.0; }
+  void updateSceneScale(const Pose3& initial_cam_from_world);
 
   KeyframeStats addFrame(const PipelineFrame& frame);
   cv::Mat prepareKeyframe(const PipelineFrame& frame, std::vector<EdgeChain>* chains,
@@ -208,7 +279,29 @@ struct Pipeline::Impl {
   std::vector<Keyframe> keyframes;
   std::vector<KeyframeStats> frames;
   bool finished = false;
+  double scene_scale = 0.0;                                // Pose units; 0 until known.
+  Eigen::Vector3d first_centre = Eigen::Vector3d::Zero();  // Initial centre of frame 0.
 };
+
+// Derives the scene scale from the first frame that moved away from frame 0 (see
+// PipelineOptions::scene_scale). The keyframes before it all sit at frame 0's centre, kept in
+// pose units; they move to the new unit, and no curve exists yet (no baseline, no depth).
+void Pipeline::Impl::updateSceneScale(const Pose3& initial_cam_from_world) {
+  if (scene_scale > 0.0) return;
+  const Eigen::Vector3d centre = initial_cam_from_world.inverseTranslation();
+  if (frames.empty()) {
+    first_centre = centre;
+    return;
+  }
+  const double distance = (centre - first_centre).norm();
+  if (!(distance > 0.0) || !std::isfinite(distance)) return;
+  CURVESFM_CHECK(map.size() == 0) << "curves exist before the scene scale is known";
+  scene_scale = distance;
+  for (Keyframe& keyframe : keyframes) {
+    keyframe.initial_cam_from_world = toSceneScale(keyframe.given_cam_from_world, distance);
+    keyframe.cam_from_world = keyframe.initial_cam_from_world;
+  }
+}
 
 cv::Mat Pipeline::Impl::prepareKeyframe(const PipelineFrame& frame, std::vector<EdgeChain>* chains,
                                         KeyframeStats* stats) {
@@ -357,7 +450,7 @@ std::vector<int> Pipeline::Impl::depthReferences(int k,
 
 void Pipeline::Impl::initialiseCurves(int k, const std::vector<EdgeChain>& chains,
                                       KeyframeStats* stats) {
-  if (k == 0 || chains.empty()) return;
+  if (k == 0 || chains.empty() || scene_scale <= 0.0) return;
   Clock::time_point start = Clock::now();
   const std::vector<int> reference_keyframes = depthReferences(k, chains);
   std::vector<DepthReferenceView> references;
@@ -493,14 +586,19 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   KeyframeStats stats;
   stats.frame_index = static_cast<int>(frames.size());
   stats.timestamp = frame.timestamp;
-  if (!selector.isKeyframe(frame.initial_cam_from_world)) {
+  updateSceneScale(frame.initial_cam_from_world);
+  if (!selector.isKeyframe(frame.initial_cam_from_world, unit())) {
     frames.push_back(stats);
     return stats;
   }
   const int k = static_cast<int>(keyframes.size());
   stats.keyframe_index = k;
   std::vector<EdgeChain> chains;
-  const cv::Mat edges = prepareKeyframe(frame, &chains, &stats);
+  // From here on every length is in the scene scale.
+  PipelineFrame scaled = frame;
+  scaled.initial_cam_from_world = toSceneScale(frame.initial_cam_from_world, unit());
+  const cv::Mat edges = prepareKeyframe(scaled, &chains, &stats);
+  keyframes.back().given_cam_from_world = frame.initial_cam_from_world;
 
   const Clock::time_point start = Clock::now();
   if (options.track_keyframe_pose && k > 0) trackPose(&keyframes[k]);
@@ -577,12 +675,23 @@ PipelineResult Pipeline::finish() {
       result.reassociation.push_back(std::move(round));
     }
   }
+  // Back from the scene scale to the unit of the poses given.
+  const double unit = impl.unit();
+  result.scene_scale = impl.scene_scale;
   for (const Keyframe& keyframe : impl.keyframes) {
     result.keyframe_timestamps.push_back(keyframe.timestamp);
-    result.keyframe_cam_from_world.push_back(keyframe.cam_from_world);
-    result.keyframe_initial_cam_from_world.push_back(keyframe.initial_cam_from_world);
+    // A pose nothing moved is returned exactly as given, without the grid's rounding.
+    const bool moved =
+        keyframe.cam_from_world.translation() != keyframe.initial_cam_from_world.translation() ||
+        keyframe.cam_from_world.rotation().coeffs() !=
+            keyframe.initial_cam_from_world.rotation().coeffs();
+    result.keyframe_cam_from_world.push_back(moved ? scaledPose(keyframe.cam_from_world, unit)
+                                                   : keyframe.given_cam_from_world);
+    result.keyframe_initial_cam_from_world.push_back(keyframe.given_cam_from_world);
   }
-  result.curves = impl.map.exportCurves(CurveSelection::kPromoted).curves;
+  for (const PolyBezier& curve : impl.map.exportCurves(CurveSelection::kPromoted).curves) {
+    result.curves.push_back(scaledCurve(curve, unit));
+  }
   result.frames = impl.frames;
   return result;
 }

@@ -25,19 +25,57 @@ namespace curvesfm {
 /// The defaults of PipelineOptions::local_ba: alternating, local scope, a window of 5 keyframes.
 SchedulerOptions defaultLocalBundleAdjustmentOptions();
 
+/// The scene scale at which the pipeline's relative defaults equal the stages' metric defaults:
+/// the distance between consecutive true camera centres of `curvesfm synth planar --frames 10`
+/// (orbit radius 0.25 m, 90 deg arc, so 2 * 0.25 m * sin(5 deg) = 43.6 mm). Not the default
+/// 30 frames' 13.5 mm: depth ranges relative to a baseline must cover sparser sequences too, and
+/// 0.2 m at 13.5 mm is 15 baselines, deeper than the plane seen from 10 frames (0.57-0.73 m at
+/// 13-17 baselines of 43.6 mm); at 4.6 baselines the 30-frame runs search from 62 mm.
+constexpr double kPlanarReferenceSceneScale = 0.0435778713738;
+
+// The defaults of the stages whose options hold lengths, in multiples of the scene scale
+// (PipelineOptions::scene_scale): the stages' metric defaults divided by
+// kPlanarReferenceSceneScale, rounded to two digits.
+/// min_depth 4.6, max_depth 460 (was 0.2 m, 20 m).
+EpipolarDepthOptions defaultPipelineDepthOptions();
+/// min_chord 2.3e-3 (was 1e-4 m).
+CurveInitialiserOptions defaultPipelineInitialiserOptions();
+/// min_depth 0.23 (was 0.01 m).
+CorrespondenceOptions defaultPipelineCorrespondenceOptions();
+/// min_keyframe_translation 0.23 (was 0.01 m).
+CurveMapOptions defaultPipelineMapOptions();
+/// lambda1 0.19 px^2 per squared scene scale (was 100 px^2/m^2), scale_sigma 2.3e-3 scene scales
+/// (was 1e-4 m).
+CurveBundleAdjustmentOptions defaultPipelineBundleAdjustmentOptions();
+
 /// Every tunable of the incremental pipeline (paper §2.3, §3.3-3.4), one struct per stage.
+///
+/// Monocular poses have an arbitrary unit, so no option is in metres: every length (depth range,
+/// minimum depths and chords, keyframe translation, the BA's length weight and scale sigma) is a
+/// multiple of the scene scale (scene_scale), and the pipeline works internally in that unit (it
+/// divides the initial poses' translations by it and multiplies the results back), so a start in
+/// millimetres or in COLMAP's arbitrary unit reconstructs the same as one in metres.
 struct PipelineOptions {
+  /// The unit of every length option (pose units). 0 derives it: the distance between the
+  /// initial camera centres of the first frame and of the first later frame whose centre differs
+  /// from it (normally frame 1, which becomes keyframe 1 when min_keyframe_translation < 1, so the
+  /// scale is also the BA's scale gauge, the initial baseline of keyframes 0 and 1). Known from
+  /// the second frame on, before anything needs it; until a frame moves, no curve starts. The
+  /// value used is PipelineResult::scene_scale. Finite, >= 0.
+  double scene_scale = 0.0;
   ImageUndistorterOptions undistort;
   EdgeDetectorOptions edges;
   EdgeChainOptions chains;
   NearestEdgeFieldOptions field;
-  EpipolarDepthOptions depth;
-  CurveInitialiserOptions initialiser;
+  EpipolarDepthOptions depth = defaultPipelineDepthOptions();  ///< Lengths in scene scales.
+  CurveInitialiserOptions initialiser = defaultPipelineInitialiserOptions();  ///< Ditto.
   /// When a new curve continues an existing one instead of starting on its own.
   CurveExtensionOptions extension;
-  CorrespondenceOptions correspondence;
-  CurveMapOptions map;              ///< Promotion, disabling, keyframe selection.
-  CurveBundleAdjustmentOptions ba;  ///< The objective of local and global BA.
+  CorrespondenceOptions correspondence = defaultPipelineCorrespondenceOptions();  ///< Ditto.
+  /// Promotion, disabling, keyframe selection (translation in scene scales).
+  CurveMapOptions map = defaultPipelineMapOptions();
+  /// The objective of local and global BA (lengths in scene scales).
+  CurveBundleAdjustmentOptions ba = defaultPipelineBundleAdjustmentOptions();
   /// After each keyframe (alternating, local scope, window 5).
   SchedulerOptions local_ba = defaultLocalBundleAdjustmentOptions();
   /// Let local BA move the window's poses (the paper's local BA) or hold every pose at its
@@ -164,6 +202,9 @@ struct PipelineResult {
   ScheduleReport global_ba;                            ///< The first global BA; empty if not run.
   std::vector<ReassociationRound> reassociation;       ///< In order; empty if none ran.
   CurveSampleCounts final_samples;                     ///< Where curve samples fall at the end.
+  /// The scene scale the run used (PipelineOptions::scene_scale, given or derived; pose units);
+  /// 0 if it was to be derived and no frame moved.
+  double scene_scale = 0.0;
 
   /// Wall time of the first global BA and of the re-association rounds' (s).
   double globalBaSeconds() const;

@@ -287,8 +287,8 @@ TEST(CorrespondenceOptions, BadValuesThrowNamingTheField) {
   options.samples_per_segment = 1;
   expectInvalid(options, "samples_per_segment");
   options = {};
-  options.min_depth_m = 0.0;
-  expectInvalid(options, "min_depth_m");
+  options.min_depth = 0.0;
+  expectInvalid(options, "min_depth");
   options = {};
   options.max_mean_edge_distance_px = std::numeric_limits<double>::quiet_NaN();
   expectInvalid(options, "max_mean_edge_distance_px");

@@ -304,7 +304,7 @@ TEST(CurveInitialiser, BadSegmentCutsTheCurve) {
 
 TEST(CurveInitialiser, ShortChordsAndLoopsAreRejected) {
   CurveInitialiserOptions huge_chords;
-  huge_chords.min_chord_m = 1.0;
+  huge_chords.min_chord = 1.0;
   CurveInitialisation result = straightScene().run(huge_chords);
   EXPECT_TRUE(result.curves.empty());
   EXPECT_EQ(result.counts.segments_short_chord, 5);
@@ -340,7 +340,7 @@ TEST(CurveInitialiserOptions, BadValuesThrowNamingTheField) {
       {"max_gap_px", [](auto& o) { o.max_gap_px = -1; }},
       {"max_relative_depth_jump", [](auto& o) { o.max_relative_depth_jump = 0.0; }},
       {"max_rms_residual_rel_chord", [](auto& o) { o.max_rms_residual_rel_chord = std::nan(""); }},
-      {"min_chord_m", [](auto& o) { o.min_chord_m = -1.0; }},
+      {"min_chord", [](auto& o) { o.min_chord = -1.0; }},
       {"max_arm_to_chord", [](auto& o) { o.max_arm_to_chord = 0.0; }}};
   for (const auto& [field, mutate] : cases) {
     CurveInitialiserOptions options;

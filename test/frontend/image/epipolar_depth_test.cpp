@@ -159,8 +159,8 @@ struct ThreeViews {
 
 EpipolarDepthOptions planeOptions() {
   EpipolarDepthOptions options;
-  options.min_depth_m = 0.5;
-  options.max_depth_m = 5.0;
+  options.min_depth = 0.5;
+  options.max_depth = 5.0;
   return options;
 }
 
@@ -233,7 +233,7 @@ TEST(EpipolarDepth, PhotographPlaneDepthsMatchTruth) {
 // rivals, but the same depths.
 TEST(EpipolarDepth, SearchesToInfinity) {
   EpipolarDepthOptions options = planeOptions();
-  options.max_depth_m = std::numeric_limits<double>::infinity();
+  options.max_depth = std::numeric_limits<double>::infinity();
   const Accuracy accuracy = runThreeViews(randomTexture(1000, 800, 3), options).accuracy;
   // Measured: 90 % valid, median 0.09 %, 1.1 % off by more than 5 %.
   EXPECT_GT(accuracy.validFraction(), 0.8);
@@ -347,7 +347,7 @@ TEST(ReferenceChooser, PrefersARealBaseline) {
   ASSERT_EQ(ranked.size(), 2u);
   EXPECT_EQ(ranked[0].index, 1);
   EXPECT_TRUE(ranked[0].eligible);
-  EXPECT_NEAR(ranked[0].baseline_m, 0.12, 1e-9);
+  EXPECT_NEAR(ranked[0].baseline, 0.12, 1e-9);
   EXPECT_GT(ranked[0].score, 5.0);
   EXPECT_EQ(ranked[1].index, 0);
   EXPECT_FALSE(ranked[1].eligible);
@@ -391,9 +391,9 @@ void expectInvalid(void (*mutate)(EpipolarDepthOptions*), const std::string& fie
 TEST(EpipolarDepthOptions, DefaultsAreValid) { EXPECT_NO_THROW(EpipolarDepthOptions().validate()); }
 
 TEST(EpipolarDepthOptions, BadValuesThrowNamingTheField) {
-  expectInvalid([](EpipolarDepthOptions* o) { o->min_depth_m = 0.0; }, "min_depth_m");
-  expectInvalid([](EpipolarDepthOptions* o) { o->max_depth_m = 0.1; }, "max_depth_m");
-  expectInvalid([](EpipolarDepthOptions* o) { o->max_depth_m = std::nan(""); }, "max_depth_m");
+  expectInvalid([](EpipolarDepthOptions* o) { o->min_depth = 0.0; }, "min_depth");
+  expectInvalid([](EpipolarDepthOptions* o) { o->max_depth = 0.1; }, "max_depth");
+  expectInvalid([](EpipolarDepthOptions* o) { o->max_depth = std::nan(""); }, "max_depth");
   expectInvalid([](EpipolarDepthOptions* o) { o->min_parallax_deg = -1.0; }, "min_parallax_deg");
   expectInvalid([](EpipolarDepthOptions* o) { o->max_gradient_epipolar_angle_deg = 90.0; },
                 "max_gradient_epipolar_angle_deg");
@@ -409,7 +409,7 @@ TEST(EpipolarDepthOptions, BadValuesThrowNamingTheField) {
   expectInvalid([](EpipolarDepthOptions* o) { o->outlier_sigmas = -1.0; }, "outlier_sigmas");
   // Infinity is a valid far limit.
   EpipolarDepthOptions options;
-  options.max_depth_m = std::numeric_limits<double>::infinity();
+  options.max_depth = std::numeric_limits<double>::infinity();
   EXPECT_NO_THROW(options.validate());
 }
 

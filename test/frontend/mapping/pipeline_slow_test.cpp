@@ -145,5 +145,49 @@ TEST(Pipeline, ExtendsCurvesThatNewEdgesContinue) {
   EXPECT_LT(started_with, started_without);
 }
 
+// The five frames of the small orbit with global BA and one re-association round, every length
+// of the scene (true and initial poses) multiplied by `unit`: the same scene in metres
+// (unit 1) or in millimetres (unit 1000).
+PipelineResult runFiveFramesInUnit(double unit) {
+  PlanarSceneOptions orbit = smallOrbit();
+  orbit.num_frames = 5;
+  const PlanarScene scene = makePlanarScene(planarTexture(), orbit);
+  PipelineOptions options;
+  options.reassociation_rounds = 1;
+  Pipeline pipeline(*scene.camera, options);
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    const Pose3& given = scene.initial_cam_from_world[i];
+    pipeline.addFrame({scene.timestamps[i], scene.images[i],
+                       Pose3(given.rotation(), given.translation() * unit)});
+  }
+  return pipeline.finish();
+}
+
+// Every threshold follows the scene scale (PipelineOptions::scene_scale), none assumes metres:
+// the same start in millimetres refines to the same trajectory, 1000 times larger.
+TEST(Pipeline, ReconstructsTheSameSceneInAnyUnit) {
+  const PipelineResult metres = runFiveFramesInUnit(1.0);
+  const PipelineResult millimetres = runFiveFramesInUnit(1000.0);
+  ASSERT_EQ(metres.keyframe_cam_from_world.size(), 5u);
+  ASSERT_EQ(millimetres.keyframe_cam_from_world.size(), 5u);
+  EXPECT_GT(metres.curves.size(), 5u);
+  EXPECT_EQ(millimetres.curves.size(), metres.curves.size());
+  EXPECT_NEAR(millimetres.scene_scale / metres.scene_scale, 1000.0, 1e-9);
+  // The refined poses must have moved, or equal results would prove nothing.
+  double largest_move = 0.0;
+  for (std::size_t j = 0; j < 5; ++j) {
+    const Pose3& m = metres.keyframe_cam_from_world[j];
+    const Pose3& mm = millimetres.keyframe_cam_from_world[j];
+    largest_move =
+        std::max(largest_move, cameraCentreDistance(m, metres.keyframe_initial_cam_from_world[j]));
+    const Eigen::Vector3d centre_mm = mm.inverseTranslation() / 1000.0;
+    EXPECT_LT((centre_mm - m.inverseTranslation()).norm(), 1e-6 * metres.scene_scale)
+        << "keyframe " << j << ": centre " << m.inverseTranslation().transpose() << " m in metres, "
+        << centre_mm.transpose() << " m from millimetres";
+    EXPECT_LT(m.rotation().angularDistance(mm.rotation()), 1e-7) << "keyframe " << j;
+  }
+  EXPECT_GT(largest_move, 1e-2 * metres.scene_scale);
+}
+
 }  // namespace
 }  // namespace curvesfm

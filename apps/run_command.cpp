@@ -28,6 +28,8 @@ struct RunInput {
   std::string init_poses_source;  // A file, a COLMAP model, or "initialiser".
   std::vector<DatasetFrame> frames;
   std::optional<PointInitialisation> initialisation;  // When the initialiser ran.
+  // Per frame, the initialiser's points it sees (the hybrid graph's input); empty otherwise.
+  std::vector<std::vector<PointSighting>> sightings;
 };
 
 namespace {
@@ -64,13 +66,37 @@ std::vector<DatasetFrame> initialisedFrames(const ImageSequence& sequence,
   return frames;
 }
 
+// The sightings of the initialiser's points per registered frame, in the order of
+// initialisedFrames().
+std::vector<std::vector<PointSighting>> initialisedSightings(const PointInitialisation& result) {
+  std::vector<int> registered_index(result.frames.size(), -1);
+  int next = 0;
+  for (std::size_t i = 0; i < result.frames.size(); ++i) {
+    if (result.frames[i].cam_from_world) registered_index[i] = next++;
+  }
+  std::vector<std::vector<PointSighting>> sightings(next);
+  for (std::size_t p = 0; p < result.points.size(); ++p) {
+    for (const TrackObservation& o : result.points[p].observations) {
+      sightings[registered_index[o.frame]].push_back({static_cast<int>(p), o.pixel});
+    }
+  }
+  return sightings;
+}
+
 std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const RunInput& input) {
   std::vector<KeyframeStats> stats;
   const int n = static_cast<int>(input.frames.size());
-  for (const DatasetFrame& frame : input.frames) {
-    const KeyframeStats s =
-        pipeline->addFrame({frame.timestamp, loadFrameImage(frame, input.sequence.camera),
-                            frame.initial_cam_from_world});
+  if (input.initialisation) {
+    std::vector<Eigen::Vector3d> points;
+    for (const InitialisedPoint& p : input.initialisation->points) points.push_back(p.position);
+    pipeline->setPoints(std::move(points));
+  }
+  for (std::size_t i = 0; i < input.frames.size(); ++i) {
+    const DatasetFrame& frame = input.frames[i];
+    const KeyframeStats s = pipeline->addFrame(
+        {frame.timestamp, loadFrameImage(frame, input.sequence.camera),
+         frame.initial_cam_from_world,
+         input.sightings.empty() ? std::vector<PointSighting>{} : input.sightings[i]});
     if (s.keyframe_index >= 0) printProgress(s, n);
     stats.push_back(s);
   }
@@ -359,6 +385,7 @@ RunInput RunCommand::loadInput() const {
   input.initialisation = initialiseSequence(input.sequence, initialiser_);
   printInitialisationSummary(input.sequence, *input.initialisation);
   input.frames = initialisedFrames(input.sequence, *input.initialisation);
+  input.sightings = initialisedSightings(*input.initialisation);
   return input;
 }
 
@@ -376,9 +403,6 @@ int RunCommand::run() const {
   std::error_code error;
   fs::create_directories(out_dir_, error);
   if (error) throw IoError(out_dir_, "cannot create the output folder: " + error.message());
-  if (input.initialisation) {
-    writeInitialisedPoints(joinPath(out_dir_, "points.ply"), *input.initialisation);
-  }
   std::printf("run: %s (%s layout), %zu of %zu images with an initial pose (%s), camera %dx%d\n",
               dataset_dir_.c_str(), d.layout.c_str(), input.frames.size(), d.images.size(),
               input.init_poses_source.c_str(), d.camera.width(), d.camera.height());
@@ -392,6 +416,14 @@ int RunCommand::run() const {
                   stampedPoses(result.keyframe_timestamps, result.keyframe_cam_from_world));
   writeTrajectory(joinPath(out_dir_, "trajectory_initial.txt"),
                   stampedPoses(result.keyframe_timestamps, result.keyframe_initial_cam_from_world));
+  if (input.initialisation) {
+    // The hybrid graph refined the points with the curves; else they are the initialiser's.
+    PointInitialisation points = *input.initialisation;
+    for (std::size_t p = 0; p < result.points.size(); ++p) {
+      points.points[p].position = result.points[p];
+    }
+    writeInitialisedPoints(joinPath(out_dir_, "points.ply"), points);
+  }
   writeCurvesPly(joinPath(out_dir_, "curves.ply"), result.curves, export_samples_per_segment_);
   writeCurvesObj(joinPath(out_dir_, "curves.obj"), result.curves, export_samples_per_segment_);
   writeConfigYaml(joinPath(out_dir_, "config.yaml"), *command_);

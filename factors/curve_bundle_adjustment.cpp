@@ -6,6 +6,7 @@
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "factors/point_reprojection_factor.h"
 #include "factors/relative_pose_factor.h"
 #include "factors/segment_length_factor.h"
 #include "factors/tangent_alignment_factor.h"
@@ -55,6 +56,25 @@ void checkFields(const CurveBundleAdjustmentInput& input) {
   }
 }
 
+void addPoints(const CurveBundleAdjustmentInput& input, const CurveBundleAdjustmentOptions& options,
+               CurveBundleAdjustmentProblem* problem) {
+  for (std::size_t p = 0; p < input.points.size(); ++p) {
+    problem->values.insert(pointKey(p), input.points[p]);
+  }
+  const NoiseModel noise{options.point_pixel_sigma,
+                         RobustKernel(options.point_kernel, options.point_kernel_width)};
+  const int num_keyframes = static_cast<int>(input.cam_from_world.size());
+  const int num_points = static_cast<int>(input.points.size());
+  for (const PointObservation& obs : input.point_observations) {
+    CURVESFM_CHECK(obs.camera_index >= 0 && obs.camera_index < num_keyframes &&
+                   obs.point_index >= 0 && obs.point_index < num_points)
+        << "observation of point " << obs.point_index << " in keyframe " << obs.camera_index
+        << " is out of range (" << num_points << " points, " << num_keyframes << " keyframes)";
+    problem->graph.emplace<PointReprojectionFactor>(
+        poseKey(obs.camera_index), pointKey(obs.point_index), obs.pixel, input.camera, noise);
+  }
+}
+
 void addMotionPrior(const std::vector<Pose3>& prior_cam_from_world,
                     const CurveBundleAdjustmentOptions& options, FactorGraph* graph) {
   if (prior_cam_from_world.size() < 2) return;
@@ -85,6 +105,8 @@ void CurveBundleAdjustmentOptions::validate() const {
   require.positive("scale_sigma", scale_sigma);
   require.positive("motion_prior_rotation_sigma_deg", motion_prior_rotation_sigma_deg);
   require.positive("motion_prior_translation_sigma_rel", motion_prior_translation_sigma_rel);
+  require.positive("point_pixel_sigma", point_pixel_sigma);
+  require.positive("point_kernel_width", point_kernel_width);
 }
 
 CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
@@ -118,6 +140,7 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
         input.camera, sampling, pixel_noise);
   }
 
+  if (options.points) addPoints(input, options, &problem);
   if (options.fix_first_pose && num_keyframes > 0) problem.config.setConstant(poseKey(0));
   if (options.fix_scale) {
     addScaleGauge(input.cam_from_world, input.scale_distance, options.scale_sigma, &problem.graph);

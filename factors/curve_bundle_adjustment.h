@@ -6,6 +6,7 @@
 #include "core/bezier.h"
 #include "core/camera.h"
 #include "core/nearest_edge_field.h"
+#include "core/point_observation.h"
 #include "core/pose3.h"
 #include "core/segment_observation.h"
 #include "factors/curve_reprojection_factor.h"
@@ -59,6 +60,15 @@ struct CurveBundleAdjustmentOptions {
   /// docs/benchmarks.md).
   double motion_prior_rotation_sigma_deg = 0.02;
   double motion_prior_translation_sigma_rel = 0.03;
+  /// The hybrid graph (issue 13): the point initialiser's points stay in the graph, one
+  /// PointReprojectionFactor per observation in a keyframe beside the curve factors, with their
+  /// own noise and kernel. Only when the input has points.
+  bool points = false;
+  /// Std dev of a point's reprojection residual (px); > 0. Its square against pixel_sigma's is
+  /// the weight of a point observation against one curve sample.
+  double point_pixel_sigma = 1.0;
+  RobustKernelType point_kernel = RobustKernelType::kHuber;  ///< Kernel on point residuals.
+  double point_kernel_width = 2.0;                           ///< Kernel width in point sigmas; > 0.
 
   /// Throws InvalidOptions naming the field, its value and the constraint.
   void validate() const;
@@ -77,10 +87,14 @@ struct CurveBundleAdjustmentInput {
   /// The trajectory whose consecutive motions CurveBundleAdjustmentOptions::motion_prior keeps
   /// (usually the initial poses); empty for none, else one pose per keyframe.
   std::vector<Pose3> motion_prior_cam_from_world;
+  /// Points in world (pointKey(p)) and their observations in the keyframes (camera_index = the
+  /// keyframe, pixels of `camera`): the hybrid graph's, used when options.points.
+  std::vector<Eigen::Vector3d> points;
+  std::vector<PointObservation> point_observations;
 };
 
 /// The graph, the starting values and what is held constant. Keys: poseKey(j) per keyframe,
-/// segmentKeys(c, i) per curve segment.
+/// segmentKeys(c, i) per curve segment, pointKey(p) per point of the hybrid graph.
 struct CurveBundleAdjustmentProblem {
   FactorGraph graph;
   Values values;
@@ -89,7 +103,8 @@ struct CurveBundleAdjustmentProblem {
 
 /// One CurveReprojectionFactor per observation, one SegmentLengthFactor and one
 /// TangentAlignmentFactor per segment (when their lambda is > 0), the gauge, and a
-/// RelativePoseFactor per consecutive keyframe pair when the motion prior is on and given. Curve
+/// RelativePoseFactor per consecutive keyframe pair when the motion prior is on and given, and
+/// with options.points a PointReprojectionFactor per point observation. Curve
 /// variables no observation touches stay in the values but get no factor. Throws CheckError for an
 /// observation out of range, a missing field, or fields that differ from the camera's size.
 CurveBundleAdjustmentProblem buildCurveBundleAdjustment(

@@ -264,7 +264,15 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
       .number("motion_prior_translation_sigma_rel", "motion-prior-translation",
               &b->motion_prior_translation_sigma_rel,
               "Std dev per axis of that motion's translation, as a fraction of the mean distance "
-              "between consecutive keyframes");
+              "between consecutive keyframes")
+      .boolean("points", "points", &b->points,
+               "Hybrid graph: keep the initialiser's points beside the curves")
+      .number("point_pixel_sigma", "point-sigma", &b->point_pixel_sigma,
+              "Std dev of a point's reprojection residual (px)")
+      .enumeration("point_kernel", "point-kernel", &b->point_kernel,
+                   "Robust kernel on point residuals")
+      .number("point_kernel_width", "point-kernel-width", &b->point_kernel_width,
+              "Point kernel width (point sigmas)");
 }
 
 void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentOptions* b,
@@ -311,7 +319,11 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
                "Refine a new keyframe's starting pose against the map before registration")
       .nested("tracking")
       .number("explained_radius_px", "explained-radius", &o->explained_radius_px,
-              "Chain pixels this close to a registered segment seed no new curve (px)");
+              "Chain pixels this close to a registered segment seed no new curve (px)")
+      .boolean("point_depth_range", "point-depth-range", &o->point_depth_range,
+               "Take each keyframe's depth range from the initialiser's points it sees")
+      .number("point_depth_margin", "point-depth-margin", &o->point_depth_margin,
+              "Widen the points' depth range by this factor on both sides");
   addImageStages(table, o, path);
   addDepth(table, &o->depth, path);
   addCurveStages(table, o, path);

@@ -11,6 +11,7 @@
 #include "core/clock.h"
 #include "core/errors.h"
 #include "core/nearest_edge_field.h"
+#include "factors/point_bundle_adjustment.h"
 #include "factors/pose_variables.h"
 #include "frontend/mapping/keyframe_selector.h"
 
@@ -27,6 +28,7 @@ struct Keyframe {
   cv::Mat image_bgr;             // Undistorted.
   cv::Mat grey;                  // Undistorted.
   std::shared_ptr<const NearestEdgeField> field;
+  std::vector<PointSighting> points;  // The hybrid graph's points it sees.
 };
 
 KeyframeView viewOf(const Keyframe& keyframe, const Camera& camera) {
@@ -181,33 +183,33 @@ SchedulerOptions defaultLocalBundleAdjustmentOptions() {
 // The stages' metric defaults in multiples of kPlanarReferenceSceneScale (pipeline.h).
 EpipolarDepthOptions defaultPipelineDepthOptions() {
   EpipolarDepthOptions options;
-  options.min_depth = 4.6;
-  options.max_depth = 460.0;
+  options.min_depth = 10.0;
+  options.max_depth = 1500.0;
   return options;
 }
 
 CurveInitialiserOptions defaultPipelineInitialiserOptions() {
   CurveInitialiserOptions options;
-  options.min_chord = 2.3e-3;
+  options.min_chord = 7.4e-3;
   return options;
 }
 
 CorrespondenceOptions defaultPipelineCorrespondenceOptions() {
   CorrespondenceOptions options;
-  options.min_depth = 0.23;
+  options.min_depth = 0.74;
   return options;
 }
 
 CurveMapOptions defaultPipelineMapOptions() {
   CurveMapOptions options;
-  options.min_keyframe_translation = 0.23;
+  options.min_keyframe_translation = 0.74;
   return options;
 }
 
 CurveBundleAdjustmentOptions defaultPipelineBundleAdjustmentOptions() {
   CurveBundleAdjustmentOptions options;
-  options.lambda1 = 0.19;
-  options.scale_sigma = 2.3e-3;
+  options.lambda1 = 0.018;
+  options.scale_sigma = 7.4e-3;
   return options;
 }
 
@@ -226,6 +228,8 @@ void PipelineOptions::validate() const {
   global_ba.validate();
   tracking.validate();
   const OptionCheck require("PipelineOptions");
+  require(point_depth_margin >= 1.0 && point_depth_margin < 1e6, "point_depth_margin",
+          point_depth_margin, "finite and >= 1");
   require(std::isfinite(scene_scale) && scene_scale >= 0.0, "scene_scale", scene_scale,
           "must be finite and >= 0 (0 derives it)");
   require(depth_reference_candidates >= 1, "depth_reference_candidates", depth_reference_candidates,
@@ -258,6 +262,7 @@ struct Pipeline::Impl {
   void registerMap(int k, cv::Mat* explained, KeyframeStats* stats);
   int reassociate();
   std::vector<int> depthReferences(int k, const std::vector<EdgeChain>& chains) const;
+  EpipolarDepthOptions depthOptions(int k) const;
   void initialiseCurves(int k, const std::vector<EdgeChain>& chains, KeyframeStats* stats);
   std::vector<OpenEnd> openEnds(int k) const;
   void addInitialCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
@@ -267,6 +272,7 @@ struct Pipeline::Impl {
                            const InitialCurve& initial, const ChainDepths& depths,
                            const std::vector<int>& reference_keyframes);
   CurveBundleAdjustmentInput bundleInput(CurveSelection selection, std::vector<int>* ids) const;
+  std::vector<int> addPointsTo(CurveBundleAdjustmentInput* input) const;
   ScheduleReport bundleAdjust(CurveSelection selection, const SchedulerOptions& scheduler,
                               bool refine_poses, CurveSampleCounts* samples);
 
@@ -279,7 +285,8 @@ struct Pipeline::Impl {
   std::vector<Keyframe> keyframes;
   std::vector<KeyframeStats> frames;
   bool finished = false;
-  double scene_scale = 0.0;                                // Pose units; 0 until known.
+  double scene_scale = 0.0;             // Pose units; 0 until known.
+  std::vector<Eigen::Vector3d> points;  // The hybrid graph's, world frame, pose units.
   Eigen::Vector3d first_centre = Eigen::Vector3d::Zero();  // Initial centre of frame 0.
 };
 
@@ -313,6 +320,7 @@ cv::Mat Pipeline::Impl::prepareKeyframe(const PipelineFrame& frame, std::vector<
   keyframe.timestamp = frame.timestamp;
   keyframe.initial_cam_from_world = frame.initial_cam_from_world;
   keyframe.cam_from_world = frame.initial_cam_from_world;
+  keyframe.points = frame.points;
 
   Clock::time_point start = Clock::now();
   keyframe.image_bgr = undistorter.undistort(frame.image_bgr).clone();
@@ -432,6 +440,27 @@ int Pipeline::Impl::reassociate() {
   return added;
 }
 
+// The depth range of keyframe k's epipolar search: from the points it sees when there are
+// enough (PipelineOptions::point_depth_range), else the options' range.
+EpipolarDepthOptions Pipeline::Impl::depthOptions(int k) const {
+  constexpr std::size_t kMinPoints = 10;
+  EpipolarDepthOptions depth = options.depth;
+  const Keyframe& keyframe = keyframes[k];
+  if (!options.point_depth_range || keyframe.points.size() < kMinPoints) return depth;
+  std::vector<double> depths;
+  for (const PointSighting& sighting : keyframe.points) {
+    const double z = (keyframe.cam_from_world * (points[sighting.point] / unit())).z();
+    if (z > 0.0) depths.push_back(z);
+  }
+  if (depths.size() < kMinPoints) return depth;
+  std::sort(depths.begin(), depths.end());
+  const double low = depths[depths.size() / 20];
+  const double high = depths[depths.size() - 1 - depths.size() / 20];
+  depth.min_depth = low / options.point_depth_margin;
+  depth.max_depth = high * options.point_depth_margin;
+  return depth;
+}
+
 std::vector<int> Pipeline::Impl::depthReferences(int k,
                                                  const std::vector<EdgeChain>& chains) const {
   std::vector<int> candidates;
@@ -442,7 +471,7 @@ std::vector<int> Pipeline::Impl::depthReferences(int k,
   for (const int j : candidates) candidate_poses.push_back(keyframes[j].cam_from_world);
   std::vector<int> references;
   for (const ReferenceCandidate& c : rankReferenceFrames(
-           keyframes[k].cam_from_world, candidate_poses, *camera, chains, options.depth)) {
+           keyframes[k].cam_from_world, candidate_poses, *camera, chains, depthOptions(k))) {
     if (c.eligible) references.push_back(candidates[c.index]);
   }
   return references;
@@ -458,7 +487,7 @@ void Pipeline::Impl::initialiseCurves(int k, const std::vector<EdgeChain>& chain
     references.push_back({keyframes[j].grey, keyframes[j].cam_from_world});
   }
   const ChainDepths depths = estimateChainDepths(keyframes[k].grey, keyframes[k].cam_from_world,
-                                                 chains, references, *camera, options.depth);
+                                                 chains, references, *camera, depthOptions(k));
   stats->valid_depths = depths.counts.valid();
   stats->depth_seconds = secondsSince(start);
 
@@ -562,12 +591,35 @@ CurveBundleAdjustmentInput Pipeline::Impl::bundleInput(CurveSelection selection,
   return input;
 }
 
+// The points the keyframes see, in the scene scale, and their observations; returns the index
+// into `points` of each point given to the BA.
+std::vector<int> Pipeline::Impl::addPointsTo(CurveBundleAdjustmentInput* input) const {
+  std::vector<int> used;
+  if (!options.ba.points || points.empty()) return used;
+  std::vector<int> index(points.size(), -1);
+  for (std::size_t j = 0; j < keyframes.size(); ++j) {
+    for (const PointSighting& sighting : keyframes[j].points) {
+      CURVESFM_CHECK(sighting.point >= 0 && sighting.point < static_cast<int>(points.size()))
+          << "keyframe " << j << " sees point " << sighting.point << " of " << points.size();
+      int& i = index[sighting.point];
+      if (i < 0) {
+        i = static_cast<int>(used.size());
+        used.push_back(sighting.point);
+        input->points.push_back(points[sighting.point] / unit());
+      }
+      input->point_observations.push_back({static_cast<int>(j), i, sighting.pixel});
+    }
+  }
+  return used;
+}
+
 ScheduleReport Pipeline::Impl::bundleAdjust(CurveSelection selection,
                                             const SchedulerOptions& scheduler, bool refine_poses,
                                             CurveSampleCounts* samples) {
   std::vector<int> ids;
-  const CurveBundleAdjustmentInput input = bundleInput(selection, &ids);
+  CurveBundleAdjustmentInput input = bundleInput(selection, &ids);
   if (input.observations.empty()) return {};
+  const std::vector<int> point_ids = addPointsTo(&input);
   CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options.ba);
   if (!refine_poses) problem.config.setConstant(VariableCategory::kPose);
   SchedulerOptions schedule = scheduler;
@@ -577,6 +629,11 @@ ScheduleReport Pipeline::Impl::bundleAdjust(CurveSelection selection,
   const std::vector<Pose3> refined = extractPoses(problem.values, keyframes.size());
   for (std::size_t j = 0; j < keyframes.size(); ++j) keyframes[j].cam_from_world = refined[j];
   map.updateCurves(ids, extractCurves(problem.values, input.curves));
+  const std::vector<Eigen::Vector3d> refined_points =
+      extractPoints(problem.values, point_ids.size());
+  for (std::size_t i = 0; i < point_ids.size(); ++i) {
+    points[point_ids[i]] = refined_points[i] * unit();
+  }
   if (samples != nullptr) *samples = countCurveSamples(problem.graph, problem.values);
   return report;
 }
@@ -692,8 +749,14 @@ PipelineResult Pipeline::finish() {
   for (const PolyBezier& curve : impl.map.exportCurves(CurveSelection::kPromoted).curves) {
     result.curves.push_back(scaledCurve(curve, unit));
   }
+  if (impl.options.ba.points) result.points = impl.points;
   result.frames = impl.frames;
   return result;
+}
+
+void Pipeline::setPoints(std::vector<Eigen::Vector3d> points_in_world) {
+  CURVESFM_CHECK(impl_->frames.empty()) << "Pipeline::setPoints after the first frame";
+  impl_->points = std::move(points_in_world);
 }
 
 const Camera& Pipeline::undistortedCamera() const { return *impl_->camera; }

@@ -26,25 +26,27 @@ namespace curvesfm {
 SchedulerOptions defaultLocalBundleAdjustmentOptions();
 
 /// The scene scale at which the pipeline's relative defaults equal the stages' metric defaults:
-/// the distance between consecutive true camera centres of `curvesfm synth planar --frames 10`
-/// (orbit radius 0.25 m, 90 deg arc, so 2 * 0.25 m * sin(5 deg) = 43.6 mm). Not the default
-/// 30 frames' 13.5 mm: depth ranges relative to a baseline must cover sparser sequences too, and
-/// 0.2 m at 13.5 mm is 15 baselines, deeper than the plane seen from 10 frames (0.57-0.73 m at
-/// 13-17 baselines of 43.6 mm); at 4.6 baselines the 30-frame runs search from 62 mm.
-constexpr double kPlanarReferenceSceneScale = 0.0435778713738;
+/// the distance between consecutive true camera centres of the default `curvesfm synth planar`
+/// (30 frames on a 0.25 m orbit's 90 deg arc: 2 * 0.25 m * sin(45/29 deg) = 13.5 mm), so that
+/// the README's run and the planar bench keep their metric behaviour. One exception: the depth
+/// range starts at 10 scene scales, not 14.8 (0.2 m), so that sparser sequences still see the
+/// plane (10 frames: 0.57-0.73 m at 13-17 baselines of 43.6 mm). Where the point initialiser
+/// gave the poses, each keyframe's depth range comes from its points instead
+/// (PipelineOptions::point_depth_range).
+constexpr double kPlanarReferenceSceneScale = 0.0135396923381;
 
 // The defaults of the stages whose options hold lengths, in multiples of the scene scale
 // (PipelineOptions::scene_scale): the stages' metric defaults divided by
 // kPlanarReferenceSceneScale, rounded to two digits.
-/// min_depth 4.6, max_depth 460 (was 0.2 m, 20 m).
+/// min_depth 10, max_depth 1500 (was 0.2 m, 20 m).
 EpipolarDepthOptions defaultPipelineDepthOptions();
-/// min_chord 2.3e-3 (was 1e-4 m).
+/// min_chord 7.4e-3 (was 1e-4 m).
 CurveInitialiserOptions defaultPipelineInitialiserOptions();
-/// min_depth 0.23 (was 0.01 m).
+/// min_depth 0.74 (was 0.01 m).
 CorrespondenceOptions defaultPipelineCorrespondenceOptions();
-/// min_keyframe_translation 0.23 (was 0.01 m).
+/// min_keyframe_translation 0.74 (was 0.01 m).
 CurveMapOptions defaultPipelineMapOptions();
-/// lambda1 0.19 px^2 per squared scene scale (was 100 px^2/m^2), scale_sigma 2.3e-3 scene scales
+/// lambda1 0.018 px^2 per squared scene scale (was 100 px^2/m^2), scale_sigma 7.4e-3 scene scales
 /// (was 1e-4 m).
 CurveBundleAdjustmentOptions defaultPipelineBundleAdjustmentOptions();
 
@@ -63,6 +65,13 @@ struct PipelineOptions {
   /// the second frame on, before anything needs it; until a frame moves, no curve starts. The
   /// value used is PipelineResult::scene_scale. Finite, >= 0.
   double scene_scale = 0.0;
+  /// With points (setPoints), a keyframe that sees at least 10 of them searches depths in
+  /// [5th percentile / point_depth_margin, 95th percentile x point_depth_margin] of their depths
+  /// instead of depth.min_depth..max_depth: a baseline is a poor yardstick for depth on real
+  /// sequences (KITTI moves a metre a frame and sees 5-80 m).
+  bool point_depth_range = true;
+  /// Factor that widens the points' depth range on both sides (unitless). Finite, >= 1.
+  double point_depth_margin = 2.0;
   ImageUndistorterOptions undistort;
   EdgeDetectorOptions edges;
   EdgeChainOptions chains;
@@ -119,10 +128,19 @@ struct PipelineOptions {
 };
 
 /// One input image with its starting pose (from an initial trajectory).
+/// One point of the hybrid graph seen in a frame (Pipeline::setPoints).
+struct PointSighting {
+  int point = -1;                                   ///< Index into the points given.
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  ///< Undistorted pixel (undistortedCamera()).
+};
+
 struct PipelineFrame {
   double timestamp = 0.0;
   cv::Mat image_bgr;             ///< Colour image as loaded (distorted), CV_8UC3.
   Pose3 initial_cam_from_world;  ///< Starting guess.
+  /// The points of setPoints() this frame sees; used when it becomes a keyframe and
+  /// ba.points is on.
+  std::vector<PointSighting> points;
 };
 
 /// What happened to one frame (a progress line and a report.json entry).
@@ -205,6 +223,9 @@ struct PipelineResult {
   /// The scene scale the run used (PipelineOptions::scene_scale, given or derived; pose units);
   /// 0 if it was to be derived and no frame moved.
   double scene_scale = 0.0;
+  /// The hybrid graph's points after the last BA, world frame, pose units; empty unless
+  /// ba.points and setPoints().
+  std::vector<Eigen::Vector3d> points;
 
   /// Wall time of the first global BA and of the re-association rounds' (s).
   double globalBaSeconds() const;
@@ -239,6 +260,12 @@ class Pipeline {
   /// Processes one frame: decides whether it becomes a keyframe and, if so, runs the frontend
   /// stages and local BA. Returns the frame's stats.
   KeyframeStats addFrame(const PipelineFrame& frame);
+
+  /// The point map of the hybrid graph (world frame, the unit of the initial poses), e.g. the
+  /// point initialiser's; frames name what they see in PipelineFrame::points. With
+  /// options.ba.points, every BA keeps the points that its keyframes see beside the curves.
+  /// Call before the first frame.
+  void setPoints(std::vector<Eigen::Vector3d> points_in_world);
 
   /// Global BA and re-association (if enabled) and the final map. Call once, after the last
   /// frame.

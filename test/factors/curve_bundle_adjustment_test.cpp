@@ -34,6 +34,34 @@ TEST(CurveBundleAdjustment, MotionPriorTiesEachConsecutivePairOnlyWhenOnAndGiven
   EXPECT_THROW(buildCurveBundleAdjustment(input, {}), CheckError);
 }
 
+TEST(CurveBundleAdjustment, HybridGraphKeepsPointsBesideCurvesWithTheirOwnNoise) {
+  CurveSceneOptions scene_options;
+  scene_options.num_keyframes = 3;
+  const CurveScene scene = makeCurveScene(scene_options);
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  // One point seen by all three keyframes at its true projections, shifted by 1 px in keyframe 1.
+  const Eigen::Vector3d point = input.curves[0].points()[0];
+  input.points = {point};
+  for (int j = 0; j < 3; ++j) {
+    Eigen::Vector2d pixel;
+    ASSERT_TRUE(input.camera->project(input.cam_from_world[j] * point, &pixel));
+    if (j == 1) pixel.x() += 1.0;
+    input.point_observations.push_back({j, 0, pixel});
+  }
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, {}).graph, "point_reprojection"), 0);
+  CurveBundleAdjustmentOptions hybrid;
+  hybrid.points = true;
+  hybrid.point_kernel = RobustKernelType::kNone;
+  hybrid.point_pixel_sigma = 0.5;
+  const CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, hybrid);
+  EXPECT_EQ(countFactors(problem.graph, "point_reprojection"), 3);
+  EXPECT_EQ(problem.values.at<Eigen::Vector3d>(pointKey(0)), point);
+  // Cost 0.5 (r / sigma)^2 of the one shifted observation: 0.5 * (1 / 0.5)^2 = 2.
+  EXPECT_NEAR(problem.graph.costByType(problem.values).at("point_reprojection").cost, 2.0, 1e-6);
+  input.point_observations.push_back({3, 0, Eigen::Vector2d::Zero()});
+  EXPECT_THROW(buildCurveBundleAdjustment(input, hybrid), CheckError);
+}
+
 // The motion prior's cost when keyframe 2 of a trajectory scaled by `scale` is moved by
 // scale * 1 mm off it.
 double motionPriorCost(const CurveScene& scene, double scale) {

@@ -578,6 +578,8 @@ void addFeatureTrackOptions(OptionsTable* table, FeatureTrackOptions* o, const O
               "Every this many frames descriptors are matched (1: every frame)")
       .number("match_overlap", "match-overlap", &o->match_overlap,
               "Earlier matching frames each matching frame is matched with (0: KLT only)")
+      .number("exhaustive_max_frames", "exhaustive-max-frames", &o->exhaustive_max_frames,
+              "A sequence of at most this many frames has every pair of matching frames matched")
       .number("min_tracked_fraction", "min-tracked-fraction", &o->min_tracked_fraction,
               "Below this fraction of KLT tracks kept, a frame and its predecessor are matched")
       .number("merge_radius_px", "merge-radius", &o->merge_radius_px,

@@ -130,6 +130,8 @@ struct FeatureTrackBuilder::State {
   // Every matching frame while the sequence may still be matched exhaustively; emptied once it
   // has more than exhaustive_max_frames frames.
   std::vector<MatchingFrame> all_matching;
+  // Two consecutive matching frames share no verified match: the order does not follow the views.
+  bool out_of_order = false;
   std::vector<FeatureTrackFrameStats> stats;
   cv::Mat previous_image;
   int last_matching_frame = -1;
@@ -183,12 +185,13 @@ struct FeatureTrackBuilder::State {
                          keypointRef(later.first_keypoint + match.index_b));
     }
     stats[later.frame].matches += static_cast<int>(matches.size());
+    if (matches.empty() && !window.empty() && &earlier == &window.back()) out_of_order = true;
   }
 
   // Matches the pairs of matching frames that the overlap window left out (exhaustive matching
   // of a short sequence).
   void matchRemainingPairs() {
-    if (numFrames() > options.exhaustive_max_frames || options.match_overlap == 0) return;
+    if (!out_of_order || numFrames() > options.exhaustive_max_frames) return;
     const Clock::time_point start = Clock::now();
     const int n = static_cast<int>(all_matching.size());
     for (int j = 0; j < n; ++j) {

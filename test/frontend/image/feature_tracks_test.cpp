@@ -79,8 +79,9 @@ TEST(FeatureTracks, DescriptorsBridgeAFrameWhereKltLosesEverything) {
 }
 
 TEST(FeatureTracks, ShortSequenceMatchesEveryPairOfMatchingFrames) {
-  // Two black frames part frames 0 and 3; the window (one earlier matching frame) never pairs
-  // them, the exhaustive matching of a short sequence does.
+  // Two black frames part frames 0 and 3 (consecutive matching frames without a match: out of
+  // order); the window (one earlier matching frame) never pairs them, the exhaustive matching of
+  // a short sequence does.
   const std::vector<int> frames = {0, -1, -1, 1};
   FeatureTrackOptions window_only;
   window_only.match_overlap = 1;

@@ -625,6 +625,8 @@ void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* o,
               "Global BA when the registered frames grew by this factor")
       .number("max_registration_trials", "max-registration-trials", &o->max_registration_trials,
               "Candidates tried per registration step before a model is stuck")
+      .number("fallback_min_inliers", "fallback-min-inliers", &o->fallback_min_inliers,
+              "When no frame registers, PnP is retried accepting this many inliers")
       .number("max_models", "max-models", &o->max_models,
               "Most sub-models started after registration failures")
       .number("min_merge_points", "min-merge-points", &o->min_merge_points,

@@ -594,6 +594,8 @@ void addFeatureTrackOptions(OptionsTable* table, FeatureTrackOptions* o, const O
               "Every this many frames descriptors are matched (1: every frame)")
       .number("match_overlap", "match-overlap", &o->match_overlap,
               "Earlier matching frames each matching frame is matched with (0: KLT only)")
+      .number("exhaustive_max_frames", "exhaustive-max-frames", &o->exhaustive_max_frames,
+              "A sequence of at most this many frames has every pair of matching frames matched")
       .number("min_tracked_fraction", "min-tracked-fraction", &o->min_tracked_fraction,
               "Below this fraction of KLT tracks kept, a frame and its predecessor are matched")
       .number("merge_radius_px", "merge-radius", &o->merge_radius_px,
@@ -639,6 +641,8 @@ void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* o,
               "Global BA when the registered frames grew by this factor")
       .number("max_registration_trials", "max-registration-trials", &o->max_registration_trials,
               "Candidates tried per registration step before a model is stuck")
+      .number("fallback_min_inliers", "fallback-min-inliers", &o->fallback_min_inliers,
+              "When no frame registers, PnP is retried accepting this many inliers")
       .number("max_models", "max-models", &o->max_models,
               "Most sub-models started after registration failures")
       .number("min_merge_points", "min-merge-points", &o->min_merge_points,

@@ -16,6 +16,8 @@ void FeatureTrackOptions::validate() const {
   require(match_interval >= 1 && match_interval <= 1000, "match_interval", match_interval,
           "in [1, 1000]");
   require(match_overlap >= 0 && match_overlap <= 20, "match_overlap", match_overlap, "in [0, 20]");
+  require(exhaustive_max_frames >= 0 && exhaustive_max_frames <= 1000, "exhaustive_max_frames",
+          exhaustive_max_frames, "in [0, 1000]");
   require(min_tracked_fraction >= 0.0 && min_tracked_fraction <= 1.0, "min_tracked_fraction",
           min_tracked_fraction, "in [0, 1]");
   require.nonNegative("merge_radius_px", merge_radius_px);
@@ -125,6 +127,11 @@ struct FeatureTrackBuilder::State {
   std::vector<Keypoint> keypoints;
   std::vector<std::pair<NodeRef, NodeRef>> links;
   std::deque<MatchingFrame> window;  // The last match_overlap matching frames.
+  // Every matching frame while the sequence may still be matched exhaustively; emptied once it
+  // has more than exhaustive_max_frames frames.
+  std::vector<MatchingFrame> all_matching;
+  // Two consecutive matching frames share no verified match: the order does not follow the views.
+  bool out_of_order = false;
   std::vector<FeatureTrackFrameStats> stats;
   cv::Mat previous_image;
   int last_matching_frame = -1;
@@ -168,6 +175,34 @@ struct FeatureTrackBuilder::State {
     return best;
   }
 
+  // Links the verified descriptor matches of `earlier` and `later` (a later matching frame).
+  void matchPair(const MatchingFrame& earlier, const MatchingFrame& later) {
+    const std::vector<FeatureMatch> matches =
+        verifiedMatches(matchFeatures(earlier.features, later.features, matching),
+                        options.verify_threshold_px, options.min_verified_matches);
+    for (const FeatureMatch& match : matches) {
+      links.emplace_back(keypointRef(earlier.first_keypoint + match.index_a),
+                         keypointRef(later.first_keypoint + match.index_b));
+    }
+    stats[later.frame].matches += static_cast<int>(matches.size());
+    if (matches.empty() && !window.empty() && &earlier == &window.back()) out_of_order = true;
+  }
+
+  // Matches the pairs of matching frames that the overlap window left out (exhaustive matching
+  // of a short sequence).
+  void matchRemainingPairs() {
+    if (!out_of_order || numFrames() > options.exhaustive_max_frames) return;
+    const Clock::time_point start = Clock::now();
+    const int n = static_cast<int>(all_matching.size());
+    for (int j = 0; j < n; ++j) {
+      // The window matched frame j with its match_overlap predecessors already.
+      for (int i = 0; i + options.match_overlap < j; ++i)
+        matchPair(all_matching[i], all_matching[j]);
+    }
+    if (n > 0) stats[all_matching.back().frame].match_seconds += secondsSince(start);
+    all_matching.clear();
+  }
+
   void makeMatchingFrame(int frame, const cv::Mat& image) {
     const Clock::time_point start = Clock::now();
     MatchingFrame m;
@@ -183,16 +218,8 @@ struct FeatureTrackBuilder::State {
     FeatureTrackFrameStats& s = stats[frame];
     s.matching_frame = true;
     s.features = m.features.size();
-    for (const MatchingFrame& earlier : window) {
-      const std::vector<FeatureMatch> matches =
-          verifiedMatches(matchFeatures(earlier.features, m.features, matching),
-                          options.verify_threshold_px, options.min_verified_matches);
-      for (const FeatureMatch& match : matches) {
-        links.emplace_back(keypointRef(earlier.first_keypoint + match.index_a),
-                           keypointRef(m.first_keypoint + match.index_b));
-        ++s.matches;
-      }
-    }
+    for (const MatchingFrame& earlier : window) matchPair(earlier, m);
+    if (numFrames() <= options.exhaustive_max_frames) all_matching.push_back(m);
     if (options.match_overlap > 0) {
       window.push_back(std::move(m));
       while (static_cast<int>(window.size()) > options.match_overlap) window.pop_front();
@@ -212,6 +239,7 @@ struct FeatureTrackBuilder::State {
     if (broken && last_matching_frame < frame - 1) makeMatchingFrame(frame - 1, previous_image);
     if (frame % options.match_interval == 0 || broken) makeMatchingFrame(frame, image);
     previous_image = image.clone();
+    if (numFrames() > options.exhaustive_max_frames) all_matching.clear();  // Too long now.
   }
 
   FeatureTracks finish() {
@@ -219,6 +247,7 @@ struct FeatureTrackBuilder::State {
     if (frames > 0 && last_matching_frame < frames - 1) {
       makeMatchingFrame(frames - 1, previous_image);
     }
+    matchRemainingPairs();
     const int num_klt = static_cast<int>(klt_colours.size());
     const int num_nodes = num_klt + static_cast<int>(keypoints.size());
     const auto node = [num_klt](NodeRef ref) { return ref >= 0 ? ref : num_klt - ref - 1; };

@@ -57,6 +57,7 @@ void PointInitialiserOptions::validate() const {
   require(global_ba_growth > 1.0 && global_ba_growth < 1e6, "global_ba_growth", global_ba_growth,
           "finite and > 1");
   require(max_registration_trials >= 1, "max_registration_trials", max_registration_trials, ">= 1");
+  require(fallback_min_inliers >= 4, "fallback_min_inliers", fallback_min_inliers, ">= 4");
   require(max_models >= 1, "max_models", max_models, ">= 1");
   require(min_merge_points >= 3, "min_merge_points", min_merge_points, ">= 3");
 }
@@ -457,18 +458,26 @@ struct PointInitialiser::State {
     return candidates;
   }
 
+  // Registers the best candidate that passes PnP's thresholds; when none does, the candidates
+  // are tried once more with fallback_min_inliers, so that a stretch of frames seeing few
+  // triangulable points (a turn towards distant background) does not close the model.
   bool registerNext(Model* model, int model_id) {
     const std::vector<std::pair<int, int>> candidates = registrationCandidates(*model);
     const int trials =
         std::min<int>(options.max_registration_trials, static_cast<int>(candidates.size()));
-    for (int c = 0; c < trials; ++c) {
-      const int frame = candidates[c].second;
-      if (tryRegister(model, frame, model_id)) return true;
+    AbsolutePoseOptions fallback = options.registration;
+    fallback.min_inliers = std::min(fallback.min_inliers, options.fallback_min_inliers);
+    for (const AbsolutePoseOptions* thresholds : {&options.registration, &fallback}) {
+      if (thresholds == &fallback && fallback.min_inliers == options.registration.min_inliers)
+        break;
+      for (int c = 0; c < trials; ++c) {
+        if (tryRegister(model, candidates[c].second, model_id, *thresholds)) return true;
+      }
     }
     return false;
   }
 
-  bool tryRegister(Model* model, int frame, int model_id) {
+  bool tryRegister(Model* model, int frame, int model_id, const AbsolutePoseOptions& thresholds) {
     const Clock::time_point start = Clock::now();
     std::vector<int> point_ids;
     std::vector<Eigen::Vector3d> points;
@@ -480,7 +489,7 @@ struct PointInitialiser::State {
       points.push_back(model->points[p].position);
       pixels.push_back(pixelOf(t, frame));
     }
-    const AbsolutePose pose = estimateAbsolutePose(*camera, points, pixels, options.registration);
+    const AbsolutePose pose = estimateAbsolutePose(*camera, points, pixels, thresholds);
     InitialisedFrame& status = out.frames[frame];
     status.correspondences = static_cast<int>(points.size());
     status.inliers = pose.num_inliers;
@@ -561,9 +570,59 @@ struct PointInitialiser::State {
     return message.str();
   }
 
-  // The Sim(3) taking `source`'s map onto `target`'s through the tracks both triangulated, with
-  // one inlier pass (residuals within 3 x their median); nullopt with too few shared points.
+  // The Sim(3) taking `source`'s map onto `target`'s: through the points both triangulated when
+  // there are enough, else through a frame both registered.
   std::optional<Sim3> mergeTransform(const Model& source, const Model& target) const {
+    if (std::optional<Sim3> t = pointMergeTransform(source, target)) return t;
+    return frameMergeTransform(source, target);
+  }
+
+  // Depths in `frame` of the live points that `model` observes in it.
+  std::vector<double> depthsIn(const Model& model, int frame) const {
+    std::vector<double> depths;
+    for (const MapPoint& p : model.points) {
+      if (p.alive() && std::find(p.frames.begin(), p.frames.end(), frame) != p.frames.end()) {
+        depths.push_back((*model.poses[frame] * p.position).z());
+      }
+    }
+    return depths;
+  }
+
+  // The Sim(3) from a frame both models registered (PnP placed it in each, so it ties them even
+  // when they triangulated different tracks, as two models that meet at one frame do): its two
+  // poses give the rotation and translation, the ratio of the median depths of the points each
+  // model sees in it the scale (global BA then refines them through the tracks that the merged
+  // frames share). Uses the shared frame where both see the most points; nullopt when none has
+  // min_merge_points in each.
+  std::optional<Sim3> frameMergeTransform(const Model& source, const Model& target) const {
+    int frame = -1;
+    std::size_t most = 0;
+    double source_depth = 0.0, target_depth = 0.0;
+    for (int f : source.registration_order) {
+      if (!target.poses[f]) continue;
+      const std::vector<double> s = depthsIn(source, f), t = depthsIn(target, f);
+      const std::size_t seen = std::min(s.size(), t.size());
+      if (static_cast<int>(seen) < options.min_merge_points || seen <= most) continue;
+      frame = f;
+      most = seen;
+      source_depth = median(s);
+      target_depth = median(t);
+    }
+    if (frame < 0 || !(source_depth > 0.0) || !(target_depth > 0.0)) return std::nullopt;
+    // cam_from_target * t == scale * cam_from_source for the shared camera.
+    const Eigen::Matrix3d r_source = source.poses[frame]->rotation().toRotationMatrix();
+    const Eigen::Matrix3d r_target = target.poses[frame]->rotation().toRotationMatrix();
+    Sim3 t;
+    t.scale = target_depth / source_depth;
+    t.rotation = r_target.transpose() * r_source;
+    t.translation = r_target.transpose() * (t.scale * source.poses[frame]->translation() -
+                                            target.poses[frame]->translation());
+    return t;
+  }
+
+  // The Sim(3) through the tracks both models triangulated, with one inlier pass (residuals
+  // within 3 x their median); nullopt with too few shared points.
+  std::optional<Sim3> pointMergeTransform(const Model& source, const Model& target) const {
     std::vector<Eigen::Vector3d> from, to;
     for (const MapPoint& p : source.points) {
       if (!p.alive() || target.point_of_track[p.track] < 0) continue;

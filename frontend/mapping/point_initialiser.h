@@ -38,7 +38,8 @@ namespace curvesfm {
 //     frame, and the scale makes the median depth of its points 1 (so the map's unit is "median
 //     scene depth at the start", written in the report).
 //  3. Registration: the unregistered frame that sees the most map points next; PnP in RANSAC and
-//     refinement (absolute_pose.h); up to max_registration_trials candidates per step.
+//     refinement (absolute_pose.h); up to max_registration_trials candidates per step, tried
+//     again with fallback_min_inliers when none passes.
 //  4. Triangulation of every track the new frame shares with registered frames and no point yet:
 //     from the new frame and the registered observation of widest angle, gated by angle
 //     (min_triangulation_angle_deg), cheirality and reprojection (max_reprojection_error_px);
@@ -50,8 +51,10 @@ namespace curvesfm {
 //     angle gate removed, and tracks re-triangulated.
 //  6. Recovery: when no frame registers, the model is closed and a new one starts from the best
 //     pair among the frames no model holds (at most max_models). Models are merged into the
-//     first by the Sim(3) fitted (Umeyama, with an inlier pass) on the tracks both triangulated;
-//     a model that shares too few is reported apart and its frames count as unregistered.
+//     first by the Sim(3) fitted (Umeyama, with an inlier pass) on the tracks both triangulated,
+//     or, with too few of those, by the poses of a frame both registered (scale: the ratio of
+//     the median depths of the points each sees in it); a model that shares neither is reported
+//     apart and its frames count as unregistered.
 //
 // Pixels: the images may be distorted; they are undistorted once (ImageUndistorter), and every
 // pixel of the result (point observations) is an undistorted pixel of undistortedCamera().
@@ -97,9 +100,15 @@ struct PointInitialiserOptions {
   double global_ba_growth = 1.2;
   /// Candidates tried per registration step before the model is declared stuck (count). >= 1.
   int max_registration_trials = 5;
+  /// When no candidate registers with registration.min_inliers, the candidates are tried once
+  /// more accepting this many inliers (count; above registration.min_inliers: no second try).
+  /// Pavilion's frames 53-58 turn towards distant background and see 27-36 triangulated points
+  /// where the chair left the view; templeSparseRing's stills 23 deg apart see 25-30. >= 4.
+  int fallback_min_inliers = 20;
   /// Most sub-models started (the first included) before giving up on the rest (count). >= 1.
   int max_models = 5;
-  /// Fewest tracks two models must both have triangulated to be merged (count). >= 3.
+  /// Fewest tracks two models must both have triangulated to be merged by them, and fewest
+  /// points each must see in a shared frame to be merged by its poses instead (count). >= 3.
   int min_merge_points = 20;
   /// Throws InvalidOptions naming the first field outside its range (also of the nested ones).
   void validate() const;

@@ -78,6 +78,23 @@ TEST(FeatureTracks, DescriptorsBridgeAFrameWhereKltLosesEverything) {
   EXPECT_TRUE(build(frames, klt_only).sharedTracks(3, 5).empty());
 }
 
+TEST(FeatureTracks, ShortSequenceMatchesEveryPairOfMatchingFrames) {
+  // Two black frames part frames 0 and 3 (consecutive matching frames without a match: out of
+  // order); the window (one earlier matching frame) never pairs them, the exhaustive matching of
+  // a short sequence does.
+  const std::vector<int> frames = {0, -1, -1, 1};
+  FeatureTrackOptions window_only;
+  window_only.match_overlap = 1;
+  window_only.exhaustive_max_frames = 0;
+  EXPECT_TRUE(build(frames, window_only).sharedTracks(0, 3).empty());
+  FeatureTrackOptions exhaustive = window_only;
+  exhaustive.exhaustive_max_frames = 4;
+  EXPECT_GT(build(frames, exhaustive).sharedTracks(0, 3).size(), 100u);
+  // One frame too many for the bound: the window alone again.
+  exhaustive.exhaustive_max_frames = 3;
+  EXPECT_TRUE(build(frames, exhaustive).sharedTracks(0, 3).empty());
+}
+
 TEST(FeatureTracks, RejectsBadOptions) {
   FeatureTrackOptions options;
   options.match_interval = 0;

@@ -46,6 +46,17 @@ TEST(PointInitialiser, RecoversThePlanarOrbitUpToSimilarity) {
   }
 }
 
+TEST(PointInitialiser, FallbackThresholdRegistersWhatTheFirstRefuses) {
+  // PnP's own threshold refuses every frame; the fallback's accepts them all.
+  const PlanarScene scene = orbitScene(8);
+  PointInitialiserOptions options;
+  options.registration.min_inliers = 100000;
+  options.max_models = 1;
+  EXPECT_EQ(initialise(scene, options).registeredFrames(), 8);
+  options.fallback_min_inliers = options.registration.min_inliers;  // No second try.
+  EXPECT_EQ(initialise(scene, options).registeredFrames(), 2);
+}
+
 TEST(PointInitialiser, ScaleConventionIsMedianDepthOneInThePairsFirstFrame) {
   const PlanarScene scene = orbitScene(10);
   const PointInitialisation result = initialise(scene, {});

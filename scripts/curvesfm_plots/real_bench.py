@@ -108,6 +108,6 @@ def trajectory_figure(out_dir, rows, sets, variants):
         axes.legend(fontsize=7)
     for index in range(len(sets), lines * columns):
         grid[index // columns][index % columns].axis("off")
-    figure.suptitle("Camera centres, aligned to the ground truth (plane of largest spread)")
+    figure.suptitle("Aligned camera centres (plane of largest spread)", fontsize=10)
     figure.tight_layout()
     return figure

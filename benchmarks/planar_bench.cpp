@@ -385,21 +385,10 @@ void printStageMedians(const std::vector<CaseResult>& results) {
   }
 }
 
-std::vector<std::string> splitAtCommas(const std::string& list, const std::string& flag) {
-  std::vector<std::string> items;
-  std::stringstream stream(list);
-  for (std::string item; std::getline(stream, item, ',');) {
-    if (item.empty()) throw CLI::ValidationError(flag, "empty item in '" + list + "'");
-    items.push_back(item);
-  }
-  if (items.empty()) throw CLI::ValidationError(flag, "no item given");
-  return items;
-}
-
 // "all" or photo file names of kPhotos; throws CLI::ValidationError naming the flag.
 std::vector<std::string> parsePhotoList(const std::string& list) {
   if (list == "all") return {};
-  std::vector<std::string> photos = splitAtCommas(list, "--photos");
+  std::vector<std::string> photos = bench::splitAtCommas(list, "--photos");
   for (const std::string& photo : photos) {
     const auto known = [&](const Photo& p) { return p.file == photo; };
     if (std::none_of(kPhotos.begin(), kPhotos.end(), known)) {
@@ -413,7 +402,7 @@ std::vector<std::string> parsePhotoList(const std::string& list) {
 // Noise levels in [0, 100] %; throws CLI::ValidationError naming the flag.
 std::vector<int> parseNoiseList(const std::string& list) {
   std::vector<int> levels;
-  for (const std::string& item : splitAtCommas(list, "--noise")) {
+  for (const std::string& item : bench::splitAtCommas(list, "--noise")) {
     std::size_t used = 0;
     int level = -1;
     try {
@@ -431,12 +420,6 @@ std::vector<int> parseNoiseList(const std::string& list) {
 void writeText(const std::string& text, const std::filesystem::path& path) {
   std::ofstream out(path);
   if (!(out << text)) throw IoError(path.string(), "cannot write");
-}
-
-std::string commandLine(int argc, char** argv) {
-  std::string command;
-  for (int i = 0; i < argc; ++i) command += (i == 0 ? "" : " ") + std::string(argv[i]);
-  return command;
 }
 
 int run(const BenchOptions& options, const std::string& command, const std::string& config_yaml) {
@@ -545,7 +528,7 @@ int main(int argc, char** argv) {
   curvesfm::OptionsTable table;
   curvesfm::addPipelineOptions(&table, &options.pipeline, "/pipeline");
   table.addFlags(&app);
-  const std::string command = curvesfm::commandLine(argc, argv);
+  const std::string command = curvesfm::bench::commandLine(argc, argv);
   const auto parse = [&] {
     curvesfm::parseCommandLine(&app, std::vector<std::string>(argv + 1, argv + argc));
   };

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -40,6 +41,26 @@ inline void printInt(const std::string& key, long long value) {
 }
 inline void printText(const std::string& key, const std::string& value) {
   std::printf("%s: %s\n", key.c_str(), value.c_str());
+}
+
+/// The items of a comma-separated list flag; CLI::ValidationError naming `flag` for an empty
+/// item or an empty list.
+inline std::vector<std::string> splitAtCommas(const std::string& list, const std::string& flag) {
+  std::vector<std::string> items;
+  std::stringstream stream(list);
+  for (std::string item; std::getline(stream, item, ',');) {
+    if (item.empty()) throw CLI::ValidationError(flag, "empty item in '" + list + "'");
+    items.push_back(item);
+  }
+  if (items.empty()) throw CLI::ValidationError(flag, "no item given");
+  return items;
+}
+
+/// argv joined by spaces, for the command line a summary quotes.
+inline std::string commandLine(int argc, char** argv) {
+  std::string command;
+  for (int i = 0; i < argc; ++i) command += (i == 0 ? "" : " ") + std::string(argv[i]);
+  return command;
 }
 
 /// Runs `parse` (which fills `app`), then `run`. Exit codes as the curvesfm binary: 2 for usage

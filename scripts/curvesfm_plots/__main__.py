@@ -30,6 +30,12 @@ def bench_command(draw):
     return run
 
 
+def real_bench_command(args):
+    from . import real_bench
+    for path in real_bench.draw(args.out_dir):
+        print("figure: %s" % path)
+
+
 def parser():
     p = argparse.ArgumentParser(prog="python3 -m curvesfm_plots",
                                 description="Figures and reports from the data curvesfm writes.")
@@ -47,6 +53,10 @@ def parser():
                                 % name.replace("-", "_"))
         c.add_argument("out_dir", help="the bench's --out folder")
         c.set_defaults(run=bench_command(draw))
+    c = commands.add_parser("real-bench", help="figures of real_bench from its CSV and "
+                            "trajectories")
+    c.add_argument("out_dir", help="the bench's --out folder")
+    c.set_defaults(run=real_bench_command)
     return p
 
 

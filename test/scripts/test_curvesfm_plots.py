@@ -8,7 +8,7 @@ import sys
 import tempfile
 import unittest
 
-from curvesfm_plots import bench_figures, inputs, report
+from curvesfm_plots import bench_figures, inputs, real_bench, report
 
 OBJ = """# curvesfm: densely sampled poly-Bezier curves, one polyline per curve
 o curve_0
@@ -213,6 +213,41 @@ class BenchFiguresTest(unittest.TestCase):
             code, message = run_package("strategy-bench", d)
         self.assertEqual(code, 1)
         self.assertIn(os.path.join(d, "runs.csv") + ":1: expected the columns", message)
+
+
+class RealBenchFiguresTest(unittest.TestCase):
+    HEADER = "set,variant,status,frames,registered,evaluated,ate_rmse,ate_mean,ate_median,note\n"
+
+    def write_bench(self, d):
+        rows = ("a,init,ok,5,5,5,0.02,0.02,0.02,\"\"\n"
+                "a,curves,ok,5,5,4,0.01,0.01,0.01,\"\"\n"
+                "a,hybrid,skipped,5,0,0,,,,\"curvesfm run has no --ba-points\"\n"
+                "b,init,failed,6,0,0,,,,\"exit code 1\"\n"
+                "b,colmap,ok,6,6,6,1.5,1.2,1.1,\"\"\n")
+        write(d, "real_bench.csv", self.HEADER + rows)
+        for s, count in (("a", 5), ("b", 6)):
+            write(d, os.path.join(s, "groundtruth.txt"),
+                  "".join(tum_line(k, *p) for k, p in enumerate(positions(count))))
+        for s, v, count in (("a", "init", 5), ("a", "curves", 4), ("b", "colmap", 6)):
+            write(d, os.path.join(s, v, "aligned_trajectory.txt"),
+                  "".join(tum_line(k, *p) for k, p in enumerate(positions(count, 1.05))))
+
+    def test_writes_the_bar_chart_and_the_trajectories(self):
+        with tempfile.TemporaryDirectory() as d:
+            self.write_bench(d)
+            paths = real_bench.draw(d)
+            self.assertTrue(all(os.path.getsize(p) > 0 for p in paths))
+        self.assertEqual([os.path.basename(p) for p in paths],
+                         ["ate_by_set.png", "trajectories.png"])
+
+    def test_missing_trajectory_names_the_file(self):
+        with tempfile.TemporaryDirectory() as d:
+            self.write_bench(d)
+            os.remove(os.path.join(d, "b", "colmap", "aligned_trajectory.txt"))
+            code, message = run_package("real-bench", d)
+        self.assertEqual(code, 1)
+        self.assertIn(os.path.join(d, "b", "colmap", "aligned_trajectory.txt") + ": cannot read",
+                      message)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,735 @@
+// real_bench: the real image sets of the data folder through the initialiser, the curve pipeline,
+// hybrid BA and COLMAP, side by side, evaluated by one code against each set's ground truth.
+//
+// For every set of kSets found under --data (a missing one is skipped with a note) and every
+// variant of --variants:
+//   init    `curvesfm init --dataset SET --out ...`: the point initialiser alone;
+//   curves  `curvesfm run --dataset SET --out ...`: with no initial poses, run starts with the
+//           point initialiser and refines its poses with the curve pipeline;
+//   hybrid  as curves plus the flags of --hybrid-flags (default `--ba-points true`: points and
+//           curves in one BA);
+//   colmap  COLMAP's feature_extractor (the set's fixed intrinsics, one camera), sequential
+//           matcher, mapper and model_converter, when `colmap` is on PATH.
+// curvesfm runs as a subprocess (--curvesfm, default the one built beside this bench); a variant
+// whose flags the executable does not list in its --help is skipped with a note, so the table
+// can name flags that a later curvesfm adds. Every trajectory (init: every registered frame;
+// curves and hybrid: the keyframes; COLMAP: every registered image) is compared with the set's
+// ground truth from loadImageSequence by compareTrajectories (Sim(3),
+// core/trajectory_evaluation.h).
+//
+// Writes into --out: real_bench.csv (one row per set and variant), real_bench.md (the table, also
+// printed), SET/groundtruth.txt and SET/VARIANT/aligned_trajectory.txt (the estimate carried onto
+// the ground truth), each run's own output and logs in SET/VARIANT/, and through `python3 -m
+// curvesfm_plots real-bench OUT` (when matplotlib is there) ate_by_set.png and trajectories.png.
+// Exit codes: 0 when every row was written (failed and skipped rows included), 1 for bad input
+// (no data folder, no known set in it), 2 for usage errors.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "apps/cli/plot_scripts.h"
+#include "benchmarks/support/bench_common.h"
+#include "benchmarks/support/subprocess.h"
+#include "core/colmap_model.h"
+#include "core/dataset_io.h"
+#include "core/errors.h"
+#include "core/image_sequence.h"
+#include "core/trajectory_evaluation.h"
+
+namespace curvesfm {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// One real image set of the data folder and what it needs to be read as the paper uses it.
+struct RealSet {
+  std::string name;    ///< The --sets name: the data folder's own name.
+  std::string subdir;  ///< The dataset folder below --data.
+  std::string camera;  ///< --camera for curvesfm and the intrinsics for COLMAP; empty: the set's.
+  int max_frames = 0;  ///< Frame cap of this set (0: all); --max-frames lowers it further.
+  int stride = 1;      ///< Every stride-th image.
+  std::string why;     ///< Why the entry differs from the defaults, for the table's notes.
+};
+
+// The sets of /work/shared/data (INDEX.md there). 7-Scenes' camera-intrinsics.txt is the depth
+// camera's; its SOURCE.md measured f = 525 for the colour images.
+const std::vector<RealSet> kSets = {
+    {"7scenes_redkitchen_tsdf300", "7scenes_redkitchen_tsdf300/data", "525,525,320,240", 0, 3,
+     "colour camera 525,525,320,240 (SOURCE.md); every 3rd frame (100 over the whole path)"},
+    {"kitti_odom06_first51", "kitti_odom06_first51/KITTI_sequence_1", "", 0, 1, ""},
+    {"middlebury_templeRing_subset", "middlebury_templeRing_subset", "", 0, 1, ""},
+    {"middlebury_templeSparseRing", "middlebury_templeSparseRing", "", 0, 1, ""},
+    {"pavilion_chair_midday", "pavilion_chair_midday/chair-sequence", "", 0, 1, ""},
+    {"strecha_fountain-P11", "strecha_fountain-P11", "", 0, 1, ""},
+};
+
+/// A curvesfm variant: the sub-command and the flags it adds to the common ones.
+struct Variant {
+  std::string name;
+  std::string command;             ///< "init" or "run"; empty for COLMAP.
+  std::vector<std::string> flags;  ///< Extra flags, as separate arguments.
+};
+
+const std::vector<std::string> kVariantNames = {"init", "curves", "hybrid", "colmap"};
+
+struct BenchOptions {
+  std::string data = "/work/shared/data";             ///< Folder holding the sets of kSets.
+  std::string out = "bench_out/real";                 ///< Output folder (created).
+  std::string curvesfm = CURVESFM_EXECUTABLE;         ///< The curvesfm executable.
+  std::vector<std::string> sets;                      ///< Names of kSets to run; empty: all.
+  std::vector<std::string> variants = kVariantNames;  ///< Variants to run, in this order.
+  std::string hybrid_flags = "--ba-points true";      ///< Extra flags of the hybrid variant.
+  int max_frames = 0;  ///< Frame cap for every set (0: each set's own cap).
+  int threads = 2;     ///< Threads for every solver flag curvesfm lists and for COLMAP.
+};
+
+/// One row of the table: a set through one variant.
+struct Row {
+  std::string set;
+  std::string variant;
+  std::string status = "ok";  ///< ok, failed or skipped.
+  std::string note;           ///< Why it failed or was skipped; caps and flags otherwise.
+  int frames = 0;             ///< Images of the set after caps.
+  int registered = 0;         ///< Frames with a pose (run: those the initialiser registered).
+  int evaluated = 0;          ///< Poses matched to the ground truth (run: keyframes).
+  ErrorStatistics ate;        ///< Sim(3) ATE (ground-truth unit).
+  ErrorStatistics rpe;        ///< RPE translation between consecutive evaluated poses.
+  // Wall times (s); NaN where the variant has no such stage.
+  double tracks_s = std::nan("");
+  double init_s = std::nan("");
+  double curves_s = std::nan("");
+  double local_ba_s = std::nan("");
+  double global_ba_s = std::nan("");
+  double extraction_s = std::nan("");
+  double matching_s = std::nan("");
+  double mapping_s = std::nan("");
+  double total_s = std::nan("");
+};
+
+std::vector<std::string> splitWords(const std::string& text) {
+  std::istringstream stream(text);
+  std::vector<std::string> words;
+  for (std::string word; stream >> word;) words.push_back(word);
+  return words;
+}
+
+std::string joinWords(const std::vector<std::string>& words, const std::string& separator = " ") {
+  std::string text;
+  for (const std::string& w : words) text += (text.empty() ? "" : separator) + w;
+  return text;
+}
+
+// ---------------------------------------------------------------------------------------------
+// curvesfm's flags.
+
+/// The long flags `curvesfm COMMAND --help` lists, read once per command.
+class FlagCatalogue {
+ public:
+  FlagCatalogue(std::string executable, std::string scratch)
+      : executable_(std::move(executable)), scratch_(std::move(scratch)) {}
+
+  const std::set<std::string>& flags(const std::string& command) {
+    auto found = flags_.find(command);
+    if (found != flags_.end()) return found->second;
+    const std::string log = scratch_ + "/help_" + command + ".txt";
+    const bench::ProcessResult r = bench::runProcess({executable_, command, "--help"}, log, log);
+    if (r.exit_code != 0) {
+      throw Error("real_bench: " + executable_ + " " + command + " --help failed (exit code " +
+                  std::to_string(r.exit_code) + "): " + bench::lastLine(log));
+    }
+    std::set<std::string>& known = flags_[command];
+    const std::string text = bench::readTextFile(log);
+    const std::regex flag("--[a-z0-9][a-z0-9-]*");
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), flag);
+         it != std::sregex_iterator(); ++it) {
+      known.insert(it->str());
+    }
+    return known;
+  }
+
+  /// The flags of `arguments` (words starting with "--") that `command` does not list.
+  std::vector<std::string> unknown(const std::string& command,
+                                   const std::vector<std::string>& arguments) {
+    std::vector<std::string> missing;
+    for (const std::string& a : arguments) {
+      if (a.rfind("--", 0) == 0 && flags(command).count(a) == 0) missing.push_back(a);
+    }
+    return missing;
+  }
+
+ private:
+  std::string executable_;
+  std::string scratch_;
+  std::map<std::string, std::set<std::string>> flags_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Evaluation.
+
+/// Fills the accuracy columns of `row` from `estimate` vs the set's ground truth and writes the
+/// aligned estimate beside the run; a trajectory that cannot be compared fails the row.
+void evaluate(const std::vector<StampedPose>& estimate, const ImageSequence& sequence,
+              const fs::path& dir, Row* row) {
+  try {
+    const TrajectoryEvaluation e =
+        compareTrajectories(estimate, sequence.ground_truth, TrajectoryEvaluationOptions{},
+                            row->variant, sequence.ground_truth_source);
+    row->evaluated = e.ate.count;
+    row->ate = e.ate;
+    row->rpe = e.rpe_translation_stats;
+    std::vector<StampedPose> aligned;
+    for (const MatchedPose& m : e.matches) {
+      aligned.push_back({m.estimate_timestamp, m.aligned_estimate});
+    }
+    writeTrajectory((dir / "aligned_trajectory.txt").string(), aligned);
+  } catch (const Error& e) {
+    row->status = "failed";
+    row->note = e.what();
+  }
+}
+
+double number(const nlohmann::json& json, const std::string& key) {
+  return json.contains(key) && json[key].is_number() ? json[key].get<double>() : std::nan("");
+}
+
+// The initialiser's part of a report.json (init: the top level; run: "initialiser").
+void readInitialiserTimes(const nlohmann::json& part, Row* row) {
+  if (!part.is_object() || !part.contains("seconds")) return;
+  const nlohmann::json& s = part["seconds"];
+  row->tracks_s = number(s, "undistort") + number(s, "klt") + number(s, "matching");
+  row->init_s = number(s, "total");
+  if (part.contains("counts")) row->registered = part["counts"].value("registered", 0);
+}
+
+// The curve pipeline's times of a run's report.json: per-frame frontend and local BA summed,
+// global BA with its re-association rounds.
+void readPipelineTimes(const nlohmann::json& report, Row* row) {
+  double frontend = 0.0;
+  double local_ba = 0.0;
+  for (const nlohmann::json& frame : report.value("frames", nlohmann::json::array())) {
+    if (!frame.contains("seconds")) continue;
+    frontend += number(frame["seconds"], "frontend");
+    local_ba += number(frame["seconds"], "local_ba");
+  }
+  row->curves_s = frontend;
+  row->local_ba_s = local_ba;
+  double global_ba = number(report.value("global_ba", nlohmann::json::object()), "total_seconds");
+  for (const nlohmann::json& round : report.value("reassociation", nlohmann::json::array())) {
+    if (round.contains("global_ba")) global_ba += number(round["global_ba"], "total_seconds");
+  }
+  row->global_ba_s = global_ba;
+}
+
+nlohmann::json readReport(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path.string(), "cannot open (the run wrote no report)");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw ParseError(path.string(), 0, "JSON", e.what());
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The variants.
+
+std::vector<std::string> sequenceFlags(const RealSet& set, const ImageSequenceOptions& sequence) {
+  std::vector<std::string> flags;
+  if (!set.camera.empty()) flags.insert(flags.end(), {"--camera", set.camera});
+  if (sequence.max_frames > 0) {
+    flags.insert(flags.end(), {"--max-frames", std::to_string(sequence.max_frames)});
+  }
+  if (sequence.stride > 1) flags.insert(flags.end(), {"--stride", std::to_string(sequence.stride)});
+  return flags;
+}
+
+void runCurvesfm(const BenchOptions& options, const Variant& variant, const RealSet& set,
+                 const ImageSequence& sequence, const ImageSequenceOptions& sequence_options,
+                 FlagCatalogue* catalogue, const fs::path& dir, Row* row) {
+  std::vector<std::string> argv = {options.curvesfm, variant.command, "--dataset",
+                                   sequence.dir,     "--out",         dir.string()};
+  const std::vector<std::string> unknown = catalogue->unknown(variant.command, variant.flags);
+  if (!unknown.empty()) {
+    row->status = "skipped";
+    row->note = "curvesfm " + variant.command + " has no " + joinWords(unknown, ", ");
+    return;
+  }
+  for (const std::string& flag : catalogue->flags(variant.command)) {
+    // Every solver's thread count (--threads, --local-ba-threads, ...), whatever curvesfm has.
+    if (flag.size() >= 9 && flag.compare(flag.size() - 7, 7, "threads") == 0) {
+      argv.insert(argv.end(), {flag, std::to_string(options.threads)});
+    }
+  }
+  const std::vector<std::string> own = sequenceFlags(set, sequence_options);
+  argv.insert(argv.end(), own.begin(), own.end());
+  argv.insert(argv.end(), variant.flags.begin(), variant.flags.end());
+  const bench::ProcessResult r =
+      bench::runProcess(argv, (dir / "stdout.txt").string(), (dir / "stderr.txt").string());
+  row->total_s = r.seconds;
+  if (!fs::exists(dir / "report.json")) {
+    row->status = "failed";
+    const std::string why = bench::lastLine(r.stderr_log);
+    row->note = "exit code " + std::to_string(r.exit_code) + (why.empty() ? "" : ": " + why);
+    return;
+  }
+  const nlohmann::json report = readReport(dir / "report.json");
+  if (variant.command == "init") {
+    readInitialiserTimes(report, row);
+  } else {
+    readInitialiserTimes(report.value("initialiser", nlohmann::json()), row);
+    readPipelineTimes(report, row);
+  }
+  if (r.exit_code != 0) {
+    row->status = "failed";
+    row->note = "exit code " + std::to_string(r.exit_code) + ": " + bench::lastLine(r.stderr_log);
+    return;
+  }
+  evaluate(readTrajectory((dir / "trajectory.txt").string()), sequence, dir, row);
+}
+
+// COLMAP's parameters for our camera: pixel centres at 0.5 there, at 0 here.
+std::pair<std::string, std::string> colmapCamera(const Camera& camera) {
+  const CameraIntrinsics& k = camera.intrinsics();
+  char text[512];
+  if (!camera.hasDistortion()) {
+    std::snprintf(text, sizeof(text), "%.10g,%.10g,%.10g,%.10g", k.fx, k.fy, k.cx + 0.5,
+                  k.cy + 0.5);
+    return {"PINHOLE", text};
+  }
+  if (k.k3 == 0.0) {
+    std::snprintf(text, sizeof(text), "%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", k.fx, k.fy,
+                  k.cx + 0.5, k.cy + 0.5, k.k1, k.k2, k.p1, k.p2);
+    return {"OPENCV", text};
+  }
+  std::snprintf(text, sizeof(text), "%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,0,0,0",
+                k.fx, k.fy, k.cx + 0.5, k.cy + 0.5, k.k1, k.k2, k.p1, k.p2, k.k3);
+  return {"FULL_OPENCV", text};
+}
+
+// Runs one COLMAP step; false (and the row failed) on a non-zero exit.
+bool colmapStep(const std::string& colmap, const std::string& step,
+                const std::vector<std::string>& arguments, const fs::path& dir, double* seconds,
+                Row* row) {
+  std::vector<std::string> argv = {colmap, step};
+  argv.insert(argv.end(), arguments.begin(), arguments.end());
+  const bench::ProcessResult r = bench::runProcess(argv, (dir / (step + ".stdout.txt")).string(),
+                                                   (dir / (step + ".stderr.txt")).string());
+  if (seconds) *seconds = r.seconds;
+  if (r.exit_code == 0) return true;
+  row->status = "failed";
+  row->note = "colmap " + step + ": exit code " + std::to_string(r.exit_code) + ": " +
+              bench::lastLine(r.stderr_log);
+  return false;
+}
+
+void runColmap(const BenchOptions& options, const std::string& colmap,
+               const ImageSequence& sequence, const fs::path& dir, Row* row) {
+  const Clock::time_point start = Clock::now();
+  const fs::path image_dir = fs::path(sequence.images.front().image_path).parent_path();
+  std::ofstream list(dir / "image_list.txt");
+  for (const SequenceImage& image : sequence.images) {
+    if (fs::path(image.image_path).parent_path() != image_dir) {
+      row->status = "skipped";
+      row->note = "images in more than one folder";
+      return;
+    }
+    list << fs::path(image.image_path).filename().string() << "\n";
+  }
+  list.close();
+  const std::string database = (dir / "database.db").string();
+  fs::remove(database);
+  const auto [model, params] = colmapCamera(sequence.camera);
+  const std::string threads = std::to_string(options.threads);
+  const std::vector<std::string> extract = {"--database_path",
+                                            database,
+                                            "--image_path",
+                                            image_dir.string(),
+                                            "--image_list_path",
+                                            (dir / "image_list.txt").string(),
+                                            "--ImageReader.single_camera",
+                                            "1",
+                                            "--ImageReader.camera_model",
+                                            model,
+                                            "--ImageReader.camera_params",
+                                            params,
+                                            "--SiftExtraction.use_gpu",
+                                            "0",
+                                            "--SiftExtraction.num_threads",
+                                            threads};
+  const std::vector<std::string> match = {"--database_path",
+                                          database,
+                                          "--SequentialMatching.overlap",
+                                          "10",
+                                          "--SequentialMatching.quadratic_overlap",
+                                          "1",
+                                          "--SiftMatching.use_gpu",
+                                          "0",
+                                          "--SiftMatching.num_threads",
+                                          threads};
+  const fs::path sparse = dir / "sparse";
+  fs::remove_all(sparse);
+  fs::create_directories(sparse);
+  // The intrinsics are the dataset's calibration: COLMAP keeps them fixed, as curvesfm does.
+  const std::vector<std::string> map = {"--database_path",
+                                        database,
+                                        "--image_path",
+                                        image_dir.string(),
+                                        "--output_path",
+                                        sparse.string(),
+                                        "--Mapper.num_threads",
+                                        threads,
+                                        "--Mapper.ba_refine_focal_length",
+                                        "0",
+                                        "--Mapper.ba_refine_principal_point",
+                                        "0",
+                                        "--Mapper.ba_refine_extra_params",
+                                        "0"};
+  if (!colmapStep(colmap, "feature_extractor", extract, dir, &row->extraction_s, row) ||
+      !colmapStep(colmap, "sequential_matcher", match, dir, &row->matching_s, row) ||
+      !colmapStep(colmap, "mapper", map, dir, &row->mapping_s, row)) {
+    row->total_s = bench::secondsSince(start);
+    return;
+  }
+  // The mapper writes one numbered folder per model; the one registering most images counts.
+  std::vector<StampedPose> best;
+  std::vector<fs::path> models;
+  for (const fs::directory_entry& entry : fs::directory_iterator(sparse)) {
+    if (entry.is_directory()) models.push_back(entry.path());
+  }
+  std::sort(models.begin(), models.end());
+  for (const fs::path& model_dir : models) {
+    const fs::path text_dir = dir / "text" / model_dir.filename();
+    fs::create_directories(text_dir);
+    if (!colmapStep(colmap, "model_converter",
+                    {"--input_path", model_dir.string(), "--output_path", text_dir.string(),
+                     "--output_type", "TXT"},
+                    dir, nullptr, row)) {
+      row->total_s = bench::secondsSince(start);
+      return;
+    }
+    try {
+      std::vector<StampedPose> poses =
+          colmapPosesForSequence(readColmapModel(text_dir.string()), sequence);
+      if (poses.size() > best.size()) best = std::move(poses);
+    } catch (const Error& e) {
+      row->note = e.what();
+    }
+  }
+  row->total_s = bench::secondsSince(start);
+  row->registered = static_cast<int>(best.size());
+  if (models.size() > 1) row->note = std::to_string(models.size()) + " models, the largest kept";
+  if (best.empty()) {
+    row->status = "failed";
+    if (row->note.empty()) row->note = "the mapper built no model";
+    return;
+  }
+  evaluate(best, sequence, dir, row);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Output.
+
+std::string formatNumber(double value, const char* format = "%.4g") {
+  if (std::isnan(value)) return "";
+  char text[64];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
+}
+
+std::string csvQuote(const std::string& text) {
+  std::string quoted = "\"";
+  for (char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+bool evaluated(const Row& r) { return r.status == "ok"; }
+
+void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
+  std::ofstream out(path);
+  if (!out) throw IoError(path.string(), "cannot open for writing");
+  out << "set,variant,status,frames,registered,evaluated,ate_rmse,ate_mean,ate_median,"
+         "rpe_translation_rmse,tracks_s,init_s,curves_s,local_ba_s,global_ba_s,extraction_s,"
+         "matching_s,mapping_s,total_s,note\n";
+  for (const Row& r : rows) {
+    const bool ok = evaluated(r);
+    const double nan = std::nan("");
+    out << r.set << "," << r.variant << "," << r.status << "," << r.frames << "," << r.registered
+        << "," << r.evaluated << "," << formatNumber(ok ? r.ate.rmse : nan, "%.9g") << ","
+        << formatNumber(ok ? r.ate.mean : nan, "%.9g") << ","
+        << formatNumber(ok ? r.ate.median : nan, "%.9g") << ","
+        << formatNumber(ok && r.rpe.count > 0 ? r.rpe.rmse : nan, "%.9g") << ","
+        << formatNumber(r.tracks_s, "%.6g") << "," << formatNumber(r.init_s, "%.6g") << ","
+        << formatNumber(r.curves_s, "%.6g") << "," << formatNumber(r.local_ba_s, "%.6g") << ","
+        << formatNumber(r.global_ba_s, "%.6g") << "," << formatNumber(r.extraction_s, "%.6g") << ","
+        << formatNumber(r.matching_s, "%.6g") << "," << formatNumber(r.mapping_s, "%.6g") << ","
+        << formatNumber(r.total_s, "%.6g") << "," << csvQuote(r.note) << "\n";
+  }
+}
+
+std::string markdownRow(const Row& r) {
+  const bool ok = evaluated(r);
+  const double nan = std::nan("");
+  const std::string colmap = std::isnan(r.extraction_s)
+                                 ? ""
+                                 : formatNumber(r.extraction_s, "%.1f") + " / " +
+                                       formatNumber(r.matching_s, "%.1f") + " / " +
+                                       formatNumber(r.mapping_s, "%.1f");
+  std::string note = r.note;
+  std::replace(note.begin(), note.end(), '|', '/');
+  std::ostringstream line;
+  line << "| " << r.set << " | " << r.variant << " | "
+       << (r.status == "skipped" ? "skipped"
+                                 : std::to_string(r.registered) + " / " + std::to_string(r.frames))
+       << " | " << (ok ? std::to_string(r.evaluated) : "") << " | "
+       << formatNumber(ok ? r.ate.rmse : nan) << " | " << formatNumber(ok ? r.ate.mean : nan)
+       << " | " << formatNumber(ok ? r.ate.median : nan) << " | "
+       << formatNumber(ok && r.rpe.count > 0 ? r.rpe.rmse : nan) << " | "
+       << formatNumber(r.tracks_s, "%.1f") << " | " << formatNumber(r.init_s, "%.1f") << " | "
+       << formatNumber(r.curves_s, "%.1f") << " | " << formatNumber(r.local_ba_s, "%.1f") << " | "
+       << formatNumber(r.global_ba_s, "%.1f") << " | " << colmap << " | "
+       << formatNumber(r.total_s, "%.1f") << " | " << (r.status == "failed" ? "failed: " : "")
+       << note << " |";
+  return line.str();
+}
+
+std::string markdownTable(const std::vector<Row>& rows) {
+  std::ostringstream out;
+  out << "| set | variant | registered | evaluated | ATE rmse | ATE mean | ATE median | RPE t rmse "
+         "| tracks s | init s | curves s | local BA s | global BA s | COLMAP extract / match / "
+         "map s | total s | note |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const Row& r : rows) out << markdownRow(r) << "\n";
+  return out.str();
+}
+
+void printProgress(const Row& r, int done, int total) {
+  if (r.status == "ok") {
+    std::printf("[%d/%d] %s %s: %d/%d registered, %d evaluated, ATE rmse %.4g, %.1f s\n", done,
+                total, r.set.c_str(), r.variant.c_str(), r.registered, r.frames, r.evaluated,
+                r.ate.rmse, r.total_s);
+  } else {
+    std::printf("[%d/%d] %s %s: %s: %s\n", done, total, r.set.c_str(), r.variant.c_str(),
+                r.status.c_str(), r.note.c_str());
+  }
+  std::fflush(stdout);
+}
+
+void printSummary(const std::vector<Row>& rows, const std::vector<std::string>& variants) {
+  for (const std::string& v : variants) {
+    int ok = 0, failed = 0, skipped = 0;
+    std::vector<double> ates;
+    double registered = 0.0;
+    for (const Row& r : rows) {
+      if (r.variant != v) continue;
+      ok += r.status == "ok";
+      failed += r.status == "failed";
+      skipped += r.status == "skipped";
+      if (r.status == "ok") {
+        ates.push_back(r.ate.rmse);
+        registered += r.frames > 0 ? static_cast<double>(r.registered) / r.frames : 0.0;
+      }
+    }
+    std::printf("%s: %d ok, %d failed, %d skipped; over the ok sets: mean registered %.0f %%\n",
+                v.c_str(), ok, failed, skipped, ok > 0 ? 100.0 * registered / ok : 0.0);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+std::vector<Variant> selectedVariants(const BenchOptions& options) {
+  std::vector<Variant> variants;
+  for (const std::string& name : options.variants) {
+    if (name == "init") variants.push_back({name, "init", {}});
+    if (name == "curves") variants.push_back({name, "run", {}});
+    if (name == "hybrid") variants.push_back({name, "run", splitWords(options.hybrid_flags)});
+    if (name == "colmap") variants.push_back({name, "", {}});
+  }
+  return variants;
+}
+
+int run(const BenchOptions& options, const std::string& command) {
+  const Clock::time_point start = Clock::now();
+  if (!fs::is_directory(options.data)) {
+    throw IoError(options.data, "no such folder (--data: the folder of the real sets)");
+  }
+  std::vector<RealSet> sets;
+  for (const RealSet& set : kSets) {
+    if (!options.sets.empty() &&
+        std::find(options.sets.begin(), options.sets.end(), set.name) == options.sets.end()) {
+      continue;
+    }
+    if (!fs::is_directory(fs::path(options.data) / set.subdir)) {
+      std::printf("# skipped %s: no folder %s\n", set.name.c_str(),
+                  (fs::path(options.data) / set.subdir).string().c_str());
+      continue;
+    }
+    sets.push_back(set);
+  }
+  if (sets.empty()) throw IoError(options.data, "none of the benchmark's sets is there");
+  const fs::path out(options.out);
+  fs::create_directories(out);
+  // COLMAP's GUI library needs a display unless Qt draws off-screen.
+  setenv("QT_QPA_PLATFORM", "offscreen", 0);
+  const std::vector<Variant> variants = selectedVariants(options);
+  const std::string colmap = bench::findOnPath("colmap");
+  FlagCatalogue catalogue(options.curvesfm, out.string());
+  std::printf("# real_bench: %zu sets x %zu variants; curvesfm %s; colmap %s\n", sets.size(),
+              variants.size(), options.curvesfm.c_str(),
+              colmap.empty() ? "not on PATH" : colmap.c_str());
+
+  std::vector<Row> rows;
+  const int total = static_cast<int>(sets.size() * variants.size());
+  for (const RealSet& set : sets) {
+    ImageSequenceOptions sequence_options;
+    sequence_options.camera = set.camera;
+    sequence_options.stride = set.stride;
+    sequence_options.max_frames = set.max_frames;
+    if (options.max_frames > 0 && (set.max_frames == 0 || options.max_frames < set.max_frames)) {
+      sequence_options.max_frames = options.max_frames;
+    }
+    const fs::path set_dir = out / set.name;
+    fs::create_directories(set_dir);
+    std::string set_note = set.why;
+    if (sequence_options.max_frames > 0) {
+      set_note += std::string(set_note.empty() ? "" : "; ") + "first " +
+                  std::to_string(sequence_options.max_frames) + " frames";
+    }
+    ImageSequence sequence;
+    try {
+      sequence =
+          loadImageSequence((fs::path(options.data) / set.subdir).string(), sequence_options);
+      if (sequence.ground_truth.empty()) throw Error("no ground truth");
+      writeTrajectory((set_dir / "groundtruth.txt").string(), sequence.ground_truth);
+    } catch (const Error& e) {
+      std::printf("# skipped %s: %s\n", set.name.c_str(), e.what());
+      continue;
+    }
+    for (const Variant& variant : variants) {
+      Row row;
+      row.set = set.name;
+      row.variant = variant.name;
+      row.frames = static_cast<int>(sequence.images.size());
+      const fs::path dir = set_dir / variant.name;
+      fs::remove_all(dir);
+      fs::create_directories(dir);
+      std::printf("[%zu/%d] %s %s: running\n", rows.size() + 1, total, set.name.c_str(),
+                  variant.name.c_str());
+      std::fflush(stdout);
+      try {
+        if (variant.name == "colmap") {
+          if (colmap.empty()) {
+            row.status = "skipped";
+            row.note = "colmap is not on PATH";
+          } else {
+            runColmap(options, colmap, sequence, dir, &row);
+          }
+        } else {
+          runCurvesfm(options, variant, set, sequence, sequence_options, &catalogue, dir, &row);
+        }
+      } catch (const Error& e) {
+        row.status = "failed";
+        row.note = e.what();
+      }
+      if (row.status == "ok") {
+        // The caps and flags that make this row differ from a plain run, then the run's note.
+        std::vector<std::string> parts;
+        for (const std::string& part : {set_note, joinWords(variant.flags), row.note}) {
+          if (!part.empty()) parts.push_back(part);
+        }
+        row.note = joinWords(parts, "; ");
+      }
+      rows.push_back(row);
+      printProgress(row, static_cast<int>(rows.size()), total);
+      // Rewritten after every row, so that a long bench stopped half-way keeps what it measured.
+      writeCsv(rows, out / "real_bench.csv");
+    }
+  }
+  const std::string table = markdownTable(rows);
+  {
+    std::ofstream md(out / "real_bench.md");
+    md << "# Real sets: initialiser, curves, hybrid BA, COLMAP\n\nCommand: `" << command
+       << "`\n\nATE and RPE: Sim(3)-aligned, in the ground truth's unit (m; Blender units for "
+          "pavilion); init and COLMAP evaluate every registered frame, curves and hybrid the "
+          "keyframes of the curve pipeline. Times are wall times in seconds.\n\n"
+       << table;
+    if (!md) throw IoError((out / "real_bench.md").string(), "cannot write");
+  }
+  std::printf("\n%s\n", table.c_str());
+  printSummary(rows, options.variants);
+  bench::print("total_seconds", bench::secondsSince(start));
+  bench::printText("outputs", (out / "{real_bench.csv,real_bench.md}").string());
+  drawFiguresIfPossible({"real-bench", out.string()});
+  return 0;
+}
+
+std::string setNames() {
+  std::string names;
+  for (const RealSet& set : kSets) names += (names.empty() ? "" : ", ") + set.name;
+  return names;
+}
+
+}  // namespace
+}  // namespace curvesfm
+
+int main(int argc, char** argv) {
+  using curvesfm::BenchOptions;
+  BenchOptions options;
+  CLI::App app{"Real sets through the initialiser, curves, hybrid BA and COLMAP, side by side"};
+  app.name("real_bench");
+  app.add_option("--data", options.data, "Folder holding the real sets")->capture_default_str();
+  app.add_option("--out", options.out, "Output folder for CSV, table, plots and runs")
+      ->capture_default_str();
+  app.add_option("--curvesfm", options.curvesfm, "The curvesfm executable")->capture_default_str();
+  app.add_option_function<std::string>(
+         "--sets",
+         [&options](const std::string& list) {
+           options.sets = curvesfm::bench::splitAtCommas(list, "--sets");
+           for (const std::string& name : options.sets) {
+             const auto known = [&](const curvesfm::RealSet& s) { return s.name == name; };
+             if (std::none_of(curvesfm::kSets.begin(), curvesfm::kSets.end(), known)) {
+               throw CLI::ValidationError("--sets", "'" + name + "' is not a benchmark set (" +
+                                                        curvesfm::setNames() + ")");
+             }
+           }
+         },
+         "Comma-separated set names to run, or all")
+      ->default_str("all");
+  app.add_option_function<std::string>(
+         "--variants",
+         [&options](const std::string& list) {
+           options.variants = curvesfm::bench::splitAtCommas(list, "--variants");
+           for (const std::string& name : options.variants) {
+             if (std::find(curvesfm::kVariantNames.begin(), curvesfm::kVariantNames.end(), name) ==
+                 curvesfm::kVariantNames.end()) {
+               throw CLI::ValidationError(
+                   "--variants", "'" + name + "' is not one of init, curves, hybrid, colmap");
+             }
+           }
+         },
+         "Comma-separated variants: init, curves, hybrid, colmap")
+      ->default_str("init,curves,hybrid,colmap");
+  app.add_option("--hybrid-flags", options.hybrid_flags,
+                 "Flags the hybrid variant adds to `curvesfm run` (one string)")
+      ->capture_default_str();
+  app.add_option("--max-frames", options.max_frames,
+                 "At most this many frames of every set (0: each set's own cap)")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  app.add_option("--threads", options.threads, "Threads of every solver and of COLMAP")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  const std::string command = curvesfm::bench::commandLine(argc, argv);
+  return curvesfm::bench::parseAndRun(app, argc, argv,
+                                      [&] { return curvesfm::run(options, command); });
+}

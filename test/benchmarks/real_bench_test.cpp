@@ -1,0 +1,47 @@
+// real_bench's command line: a bad set or variant name and a missing data folder end in one
+// message naming the flag or folder and a non-zero exit, before anything runs.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "test/support/run_executable.h"
+
+namespace curvesfm {
+namespace {
+
+using ::testing::HasSubstr;
+
+testing::CommandResult runRealBench(const std::string& arguments) {
+  return testing::runCommand(REAL_BENCH_EXECUTABLE, arguments);
+}
+
+TEST(RealBenchCommandLine, RejectsAnUnknownVariant) {
+  const testing::CommandResult r = runRealBench("--variants init,points");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output,
+              HasSubstr("--variants: 'points' is not one of init, curves, hybrid, colmap"));
+}
+
+TEST(RealBenchCommandLine, RejectsAnUnknownSet) {
+  const testing::CommandResult r = runRealBench("--sets kitti");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--sets: 'kitti' is not a benchmark set"));
+}
+
+TEST(RealBenchCommandLine, NamesAMissingDataFolder) {
+  const std::string out = ::testing::TempDir() + "real_bench_no_data";
+  const testing::CommandResult r = runRealBench("--data /nonexistent/data --out " + out);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("/nonexistent/data: no such folder"));
+}
+
+TEST(RealBenchCommandLine, NamesADataFolderWithoutTheSets) {
+  const std::string out = ::testing::TempDir() + "real_bench_empty_data";
+  const testing::CommandResult r = runRealBench("--data " + ::testing::TempDir() + " --out " + out);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("none of the benchmark's sets is there"));
+}
+
+}  // namespace
+}  // namespace curvesfm

@@ -62,7 +62,7 @@ struct RealSet {
   std::string why;     ///< Why the entry differs from the defaults, for the table's notes.
 };
 
-// The sets of /work/shared/data (INDEX.md there). 7-Scenes' camera-intrinsics.txt is the depth
+// The sets of ../shared/data (INDEX.md there). 7-Scenes' camera-intrinsics.txt is the depth
 // camera's; its SOURCE.md measured f = 525 for the colour images.
 const std::vector<RealSet> kSets = {
     {"7scenes_redkitchen_tsdf300", "7scenes_redkitchen_tsdf300/data", "525,525,320,240", 0, 3,
@@ -84,8 +84,8 @@ struct Variant {
 const std::vector<std::string> kVariantNames = {"init", "curves", "hybrid", "colmap"};
 
 struct BenchOptions {
-  std::string data = "/work/shared/data";             ///< Folder holding the sets of kSets.
-  std::string out = "bench_out/real";                 ///< Output folder (created).
+  std::string data = "../shared/data";  ///< Folder holding the sets of kSets (from the repo root).
+  std::string out = "bench_out/real";   ///< Output folder (created).
   std::string curvesfm = CURVESFM_EXECUTABLE;         ///< The curvesfm executable.
   std::vector<std::string> sets;                      ///< Names of kSets to run; empty: all.
   std::vector<std::string> variants = kVariantNames;  ///< Variants to run, in this order.

@@ -70,8 +70,7 @@ TEST_F(TumDatasetTest, NoInitialPosesNamesTheFileItLookedFor) {
 
 TEST_F(TumDatasetTest, PosesThatMatchNoImageNameBothFiles) {
   writePoses("poses.txt", {5.0, 6.0});
-  EXPECT_THAT([&] {
-    loadTumDataset(dir_.string(), path("poses.txt"), 0.02); },
+  EXPECT_THAT([&] { loadTumDataset(dir_.string(), path("poses.txt"), 0.02); },
               ::testing::ThrowsMessage<ParseError>(
                   ::testing::AllOf(HasSubstr(path("poses.txt")), HasSubstr(dir_.string()))));
 }

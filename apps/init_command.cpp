@@ -61,6 +61,7 @@ int InitCommand::run() const {
   report["total_seconds"] = secondsSince(start);
   writeJsonFile((fs::path(out_dir_) / "report.json").string(), report);
   std::printf("written: %s (trajectory.txt, points.ply, report.json)\n", out_dir_.c_str());
+  std::fflush(stdout);  // The summary first, then why nothing was reconstructed.
   if (result.registeredFrames() == 0) {
     std::fprintf(stderr, "init: nothing reconstructed: %s\n", result.failure.c_str());
     return 1;

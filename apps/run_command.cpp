@@ -474,6 +474,7 @@ int RunCommand::run() const {
       "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, report.json, "
       "config.yaml%s%s)\n",
       out_dir_.c_str(), input.initialisation ? ", points.ply" : "", overlays_ ? ", overlays/" : "");
+  std::fflush(stdout);  // The summary first, then why the run failed, if it did.
   if (result.curves.empty()) {
     std::fprintf(stderr,
                  "run: no curve reached the global map: nothing was reconstructed (see "

@@ -105,7 +105,7 @@ cv::Mat loadFrameImage(const DatasetFrame& frame, const Camera& camera) {
   cv::Mat image = readColorImage(frame.image_path);
   if (image.cols != camera.width() || image.rows != camera.height()) {
     throw IoError(frame.image_path, "is " + std::to_string(image.cols) + "x" +
-                                        std::to_string(image.rows) + " px, camera.yaml says " +
+                                        std::to_string(image.rows) + " px, the camera says " +
                                         std::to_string(camera.width()) + "x" +
                                         std::to_string(camera.height()));
   }

@@ -75,5 +75,25 @@ TEST_F(TumDatasetTest, PosesThatMatchNoImageNameBothFiles) {
                   ::testing::AllOf(HasSubstr(path("poses.txt")), HasSubstr(dir_.string()))));
 }
 
+// run's initial poses: a file given, else DIR/init_poses.txt, else none (the initialiser's turn);
+// a COLMAP model folder is read through colmapPosesForSequence (tested in colmap_model_test).
+TEST_F(TumDatasetTest, InitialPosesComeFromTheFileGivenTheDatasetsOwnOrNowhere) {
+  ImageSequenceOptions options;
+  options.layout = DatasetLayout::kTum;
+  const ImageSequence sequence = loadImageSequence(dir_.string(), options);
+  std::string source = "stale";
+  EXPECT_TRUE(readInitialPoses("", sequence, &source).empty());
+  EXPECT_EQ(source, "");
+  writePoses("init_poses.txt", {1.0, 1.2});
+  EXPECT_EQ(readInitialPoses("", sequence, &source).size(), 2u);
+  EXPECT_EQ(source, path("init_poses.txt"));
+  writePoses("other.txt", {1.0, 1.1, 1.2});
+  const std::vector<StampedPose> poses = readInitialPoses(path("other.txt"), sequence, &source);
+  EXPECT_EQ(poses.size(), 3u);
+  EXPECT_EQ(source, path("other.txt"));
+  EXPECT_EQ(framesWithPoses(sequence, poses, 0.02, source).size(), 3u);
+  EXPECT_THROW(readInitialPoses(path("missing.txt"), sequence, &source), IoError);
+}
+
 }  // namespace
 }  // namespace curvesfm

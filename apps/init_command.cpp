@@ -34,9 +34,7 @@ int InitCommand::run() const {
   validate();
   const Clock::time_point start = Clock::now();
   const ImageSequence sequence = loadImageSequence(dataset_dir_, sequence_);
-  std::error_code error;
-  fs::create_directories(out_dir_, error);
-  if (error) throw IoError(out_dir_, "cannot create the output folder: " + error.message());
+  createOutputFolder(out_dir_);
   std::printf("init: %s (%s layout), %zu images, camera %dx%d from %s\n", dataset_dir_.c_str(),
               sequence.layout.c_str(), sequence.images.size(), sequence.camera.width(),
               sequence.camera.height(), sequence.camera_source.c_str());

@@ -55,34 +55,6 @@ void printProgress(const KeyframeStats& s, int frames) {
   std::fflush(stdout);
 }
 
-std::vector<DatasetFrame> initialisedFrames(const ImageSequence& sequence,
-                                            const PointInitialisation& result) {
-  std::vector<DatasetFrame> frames;
-  for (std::size_t i = 0; i < result.frames.size(); ++i) {
-    if (!result.frames[i].cam_from_world) continue;
-    frames.push_back({sequence.images[i].timestamp, sequence.images[i].image_path,
-                      *result.frames[i].cam_from_world});
-  }
-  return frames;
-}
-
-// The sightings of the initialiser's points per registered frame, in the order of
-// initialisedFrames().
-std::vector<std::vector<PointSighting>> initialisedSightings(const PointInitialisation& result) {
-  std::vector<int> registered_index(result.frames.size(), -1);
-  int next = 0;
-  for (std::size_t i = 0; i < result.frames.size(); ++i) {
-    if (result.frames[i].cam_from_world) registered_index[i] = next++;
-  }
-  std::vector<std::vector<PointSighting>> sightings(next);
-  for (std::size_t p = 0; p < result.points.size(); ++p) {
-    for (const TrackObservation& o : result.points[p].observations) {
-      sightings[registered_index[o.frame]].push_back({static_cast<int>(p), o.pixel});
-    }
-  }
-  return sightings;
-}
-
 std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const RunInput& input) {
   std::vector<KeyframeStats> stats;
   const int n = static_cast<int>(input.frames.size());
@@ -400,9 +372,7 @@ int RunCommand::run() const {
                  input.frames.size(), input.initialisation->failure.c_str());
     return 1;
   }
-  std::error_code error;
-  fs::create_directories(out_dir_, error);
-  if (error) throw IoError(out_dir_, "cannot create the output folder: " + error.message());
+  createOutputFolder(out_dir_);
   std::printf("run: %s (%s layout), %zu of %zu images with an initial pose (%s), camera %dx%d\n",
               dataset_dir_.c_str(), d.layout.c_str(), input.frames.size(), d.images.size(),
               input.init_poses_source.c_str(), d.camera.width(), d.camera.height());
@@ -418,11 +388,8 @@ int RunCommand::run() const {
                   stampedPoses(result.keyframe_timestamps, result.keyframe_initial_cam_from_world));
   if (input.initialisation) {
     // The hybrid graph refined the points with the curves; else they are the initialiser's.
-    PointInitialisation points = *input.initialisation;
-    for (std::size_t p = 0; p < result.points.size(); ++p) {
-      points.points[p].position = result.points[p];
-    }
-    writeInitialisedPoints(joinPath(out_dir_, "points.ply"), points);
+    writeInitialisedPoints(joinPath(out_dir_, "points.ply"), *input.initialisation,
+                           result.points.empty() ? nullptr : &result.points);
   }
   writeCurvesPly(joinPath(out_dir_, "curves.ply"), result.curves, export_samples_per_segment_);
   writeCurvesObj(joinPath(out_dir_, "curves.obj"), result.curves, export_samples_per_segment_);

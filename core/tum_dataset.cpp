@@ -101,15 +101,18 @@ std::vector<StampedPose> readInitialPoses(const std::string& path, const ImageSe
   return readTrajectory(file);
 }
 
-cv::Mat loadFrameImage(const DatasetFrame& frame, const Camera& camera) {
-  cv::Mat image = readColorImage(frame.image_path);
+cv::Mat loadCameraImage(const std::string& path, const Camera& camera) {
+  cv::Mat image = readColorImage(path);
   if (image.cols != camera.width() || image.rows != camera.height()) {
-    throw IoError(frame.image_path, "is " + std::to_string(image.cols) + "x" +
-                                        std::to_string(image.rows) + " px, the camera says " +
-                                        std::to_string(camera.width()) + "x" +
-                                        std::to_string(camera.height()));
+    throw IoError(path, "is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+                            " px, the camera says " + std::to_string(camera.width()) + "x" +
+                            std::to_string(camera.height()));
   }
   return image;
+}
+
+cv::Mat loadFrameImage(const DatasetFrame& frame, const Camera& camera) {
+  return loadCameraImage(frame.image_path, camera);
 }
 
 }  // namespace curvesfm

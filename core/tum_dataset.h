@@ -57,6 +57,10 @@ std::vector<DatasetFrame> framesWithPoses(const ImageSequence& sequence,
 std::vector<StampedPose> readInitialPoses(const std::string& path, const ImageSequence& sequence,
                                           std::string* source);
 
+/// Decodes the image at `path` (8-bit BGR); IoError naming it if it does not load or its size
+/// differs from `camera`'s.
+cv::Mat loadCameraImage(const std::string& path, const Camera& camera);
+
 /// Decodes `frame`'s image (8-bit BGR); IoError naming it if it does not load or its size differs
 /// from `camera`'s.
 cv::Mat loadFrameImage(const DatasetFrame& frame, const Camera& camera);

@@ -1,6 +1,7 @@
 #include "apps/cli/cli_options.h"
 
 #include <algorithm>
+#include <filesystem>
 
 #include "apps/cli/config_file.h"
 #include "core/errors.h"
@@ -87,6 +88,12 @@ nlohmann::json optionsToJson(const CLI::App& command) {
   nlohmann::json json = nlohmann::json::object();
   for (const auto& [name, value] : effectiveOptions(command)) json[name] = value;
   return json;
+}
+
+void createOutputFolder(const std::string& dir) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw IoError(dir, "cannot create the output folder: " + error.message());
 }
 
 }  // namespace curvesfm

@@ -50,4 +50,7 @@ void addConfigFlag(CLI::App* command);
 /// The effective options of `command` as a JSON object (for report.json).
 nlohmann::json optionsToJson(const CLI::App& command);
 
+/// Creates a command's --out folder (and its parents) if needed; IoError naming it otherwise.
+void createOutputFolder(const std::string& dir);
+
 }  // namespace curvesfm

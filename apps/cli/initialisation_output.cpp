@@ -4,10 +4,12 @@
 #include <map>
 
 #include "apps/cli/report_json.h"
+#include "core/check.h"
 #include "core/clock.h"
 #include "core/curve_export.h"
 #include "core/errors.h"
 #include "core/trajectory_evaluation.h"
+#include "core/tum_dataset.h"
 
 namespace curvesfm {
 namespace {
@@ -66,15 +68,7 @@ PointInitialisation initialiseSequence(const ImageSequence& sequence,
   const int every = std::max(1, frames / 10);
   const Clock::time_point start = Clock::now();
   for (int i = 0; i < frames; ++i) {
-    const cv::Mat image = readColorImage(sequence.images[i].image_path);
-    if (image.cols != sequence.camera.width() || image.rows != sequence.camera.height()) {
-      throw IoError(sequence.images[i].image_path,
-                    "is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                        " but the camera (" + sequence.camera_source + ") is " +
-                        std::to_string(sequence.camera.width()) + "x" +
-                        std::to_string(sequence.camera.height()));
-    }
-    initialiser.addFrame(image);
+    initialiser.addFrame(loadCameraImage(sequence.images[i].image_path, sequence.camera));
     if ((i + 1) % every == 0 || i + 1 == frames) {
       std::printf("init: tracked %d/%d frames (%.1f s)\n", i + 1, frames, secondsSince(start));
       std::fflush(stdout);
@@ -89,24 +83,52 @@ PointInitialisation initialiseSequence(const ImageSequence& sequence,
   return initialiser.finish();
 }
 
-std::vector<StampedPose> initialisedTrajectory(const ImageSequence& sequence,
-                                               const PointInitialisation& result) {
-  std::vector<double> timestamps;
-  std::vector<Pose3> poses;
+std::vector<DatasetFrame> initialisedFrames(const ImageSequence& sequence,
+                                            const PointInitialisation& result) {
+  std::vector<DatasetFrame> frames;
   for (std::size_t i = 0; i < result.frames.size(); ++i) {
     if (!result.frames[i].cam_from_world) continue;
-    timestamps.push_back(sequence.images[i].timestamp);
-    poses.push_back(*result.frames[i].cam_from_world);
+    frames.push_back({sequence.images[i].timestamp, sequence.images[i].image_path,
+                      *result.frames[i].cam_from_world});
   }
-  return stampedPoses(timestamps, poses);
+  return frames;
 }
 
-void writeInitialisedPoints(const std::string& path, const PointInitialisation& result) {
+std::vector<std::vector<PointSighting>> initialisedSightings(const PointInitialisation& result) {
+  std::vector<int> registered_index(result.frames.size(), -1);
+  int next = 0;
+  for (std::size_t i = 0; i < result.frames.size(); ++i) {
+    if (result.frames[i].cam_from_world) registered_index[i] = next++;
+  }
+  std::vector<std::vector<PointSighting>> sightings(next);
+  for (std::size_t p = 0; p < result.points.size(); ++p) {
+    for (const TrackObservation& o : result.points[p].observations) {
+      sightings[registered_index[o.frame]].push_back({static_cast<int>(p), o.pixel});
+    }
+  }
+  return sightings;
+}
+
+std::vector<StampedPose> initialisedTrajectory(const ImageSequence& sequence,
+                                               const PointInitialisation& result) {
+  std::vector<StampedPose> trajectory;
+  for (const DatasetFrame& frame : initialisedFrames(sequence, result)) {
+    trajectory.push_back({frame.timestamp, frame.initial_cam_from_world.inverse()});
+  }
+  return trajectory;
+}
+
+void writeInitialisedPoints(const std::string& path, const PointInitialisation& result,
+                            const std::vector<Eigen::Vector3d>* refined_positions) {
+  CURVESFM_CHECK(!refined_positions || refined_positions->size() == result.points.size())
+      << refined_positions->size() << " refined positions for " << result.points.size()
+      << " points";
   std::vector<ExportedPoint> points;
   points.reserve(result.points.size());
-  for (const InitialisedPoint& p : result.points) {
-    points.push_back({p.position, p.colour_bgr[2], p.colour_bgr[1], p.colour_bgr[0],
-                      static_cast<int>(p.observations.size())});
+  for (std::size_t i = 0; i < result.points.size(); ++i) {
+    const InitialisedPoint& p = result.points[i];
+    points.push_back({refined_positions ? (*refined_positions)[i] : p.position, p.colour_bgr[2],
+                      p.colour_bgr[1], p.colour_bgr[0], static_cast<int>(p.observations.size())});
   }
   writePointsPly(path, points);
 }

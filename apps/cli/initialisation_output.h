@@ -6,6 +6,8 @@
 
 #include "core/dataset_io.h"
 #include "core/image_sequence.h"
+#include "core/tum_dataset.h"
+#include "frontend/mapping/pipeline.h"
 #include "frontend/mapping/point_initialiser.h"
 
 namespace curvesfm {
@@ -19,12 +21,22 @@ namespace curvesfm {
 PointInitialisation initialiseSequence(const ImageSequence& sequence,
                                        const PointInitialiserOptions& options);
 
+/// The registered frames with their images and poses, in sequence order: the frames `run` feeds
+/// to the curve pipeline.
+std::vector<DatasetFrame> initialisedFrames(const ImageSequence& sequence,
+                                            const PointInitialisation& result);
+
+/// Per frame of initialisedFrames(), the map points it sees (the hybrid graph's input).
+std::vector<std::vector<PointSighting>> initialisedSightings(const PointInitialisation& result);
+
 /// The registered frames as a TUM trajectory (camera-to-world, the images' timestamps).
 std::vector<StampedPose> initialisedTrajectory(const ImageSequence& sequence,
                                                const PointInitialisation& result);
 
-/// Writes the map as points.ply (colour and track length per point) at `path`.
-void writeInitialisedPoints(const std::string& path, const PointInitialisation& result);
+/// Writes the map as points.ply (colour and track length per point) at `path`; with
+/// `refined_positions` (one per point, e.g. after the hybrid graph's BA) at those positions.
+void writeInitialisedPoints(const std::string& path, const PointInitialisation& result,
+                            const std::vector<Eigen::Vector3d>* refined_positions = nullptr);
 
 /// The report.json part of the initialiser: counts, the scale convention, the initial pair, per
 /// frame its registration (status, reason, correspondences, inliers), every BA's summary and the

@@ -140,7 +140,7 @@ struct PipelineFrame {
   Pose3 initial_cam_from_world;  ///< Starting guess.
   /// The points of setPoints() this frame sees; used when it becomes a keyframe and
   /// ba.points is on.
-  std::vector<PointSighting> points;
+  std::vector<PointSighting> points = {};
 };
 
 /// What happened to one frame (a progress line and a report.json entry).

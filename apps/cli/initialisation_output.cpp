@@ -185,7 +185,10 @@ nlohmann::json initialisationToJson(const ImageSequence& sequence,
             {"local_ba", t.local_ba},
             {"global_ba", t.global_ba},
             {"merge", t.merge},
-            {"total", t.total}}}};
+            {"total", t.total},
+            {"tracks_ms_per_640x480_frame",
+             t.tracksMsPerVgaFrame(static_cast<int>(result.frames.size()), sequence.camera.width(),
+                                   sequence.camera.height())}}}};
 }
 
 nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
@@ -208,12 +211,14 @@ nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
   }
   const InitialiserTimes& t = result.seconds;
   std::printf(
-      "init time: tracks %.2f s (KLT %.2f, descriptors %.2f; %.1f ms per frame), pair search "
-      "%.2f s, registration %.2f s, triangulation %.2f s, local BA %.2f s, global BA %.2f s, "
-      "total %.2f s\n",
+      "init time: tracks %.2f s (KLT %.2f, descriptors %.2f; %.1f ms per frame, %.1f ms per "
+      "640x480 "
+      "frame), pair search %.2f s, registration %.2f s, triangulation %.2f s, "
+      "local BA %.2f s, global BA %.2f s, total %.2f s\n",
       t.klt + t.matching + t.undistort, t.klt, t.matching,
-      frames > 0 ? 1e3 * (t.klt + t.matching + t.undistort) / frames : 0.0, t.pair_search,
-      t.registration, t.triangulation, t.local_ba, t.global_ba, t.total);
+      frames > 0 ? 1e3 * (t.klt + t.matching + t.undistort) / frames : 0.0,
+      t.tracksMsPerVgaFrame(frames, sequence.camera.width(), sequence.camera.height()),
+      t.pair_search, t.registration, t.triangulation, t.local_ba, t.global_ba, t.total);
   for (const auto& [scope, totals] : baTotals(result)) {
     std::printf("init BA %s: %d solves, %d iterations, %.2f s\n", scope.c_str(), totals.solves,
                 totals.iterations, totals.seconds);

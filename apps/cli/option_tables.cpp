@@ -393,6 +393,8 @@ void addFeatureMatchingOptions(OptionsTable* table, FeatureMatchingOptions* o,
       .enumeration("kind", "kind", &o->kind, "Descriptor detected and matched")
       .number("max_features", "max-features", &o->max_features,
               "Most features kept per image, the strongest first")
+      .number("detection_scale", "detection-scale", &o->detection_scale,
+              "Features are detected on the image resized by this factor (1: full size)")
       .number("ratio", "ratio", &o->ratio,
               "Lowe's ratio: nearest over second-nearest descriptor distance below this")
       .boolean("mutual_check", "mutual-check", &o->mutual_check,
@@ -597,7 +599,9 @@ void addFeatureTrackOptions(OptionsTable* table, FeatureTrackOptions* o, const O
       .number("exhaustive_max_frames", "exhaustive-max-frames", &o->exhaustive_max_frames,
               "A sequence of at most this many frames has every pair of matching frames matched")
       .number("min_tracked_fraction", "min-tracked-fraction", &o->min_tracked_fraction,
-              "Below this fraction of KLT tracks kept, a frame and its predecessor are matched")
+              "Below this fraction of KLT tracks kept, a frame is a matching frame")
+      .boolean("match_frame_before_break", "match-frame-before-break", &o->match_frame_before_break,
+               "The frame before such a break is a matching frame too")
       .number("merge_radius_px", "merge-radius", &o->merge_radius_px,
               "A keypoint joins the KLT track this close in its frame (px)")
       .number("verify_threshold_px", "verify-threshold", &o->verify_threshold_px,
@@ -646,7 +650,9 @@ void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* o,
       .number("max_models", "max-models", &o->max_models,
               "Most sub-models started after registration failures")
       .number("min_merge_points", "min-merge-points", &o->min_merge_points,
-              "Fewest shared points to merge two sub-models by Sim(3)");
+              "Fewest shared points to merge two sub-models by Sim(3)")
+      .threads("tracking_threads", "tracking-threads", &o->tracking_threads,
+               "OpenCV threads while building the tracks (0: every core)");
   table
       ->group(&o->undistort, "ImageUndistorterOptions", path + "/undistort", "points-undistort-",
               heading)

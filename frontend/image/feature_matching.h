@@ -43,12 +43,21 @@ struct EnumNames<FeatureKind> {
 /// How features are detected and matched. Defaults follow COLMAP's sequential matcher.
 struct FeatureMatchingOptions {
   /// Descriptor detected and matched: sift (L2) or orb (Hamming). Measured on one core at
-  /// 640x480 with the defaults (textured planar views, about 1350 SIFT or 2000 ORB features):
-  /// SIFT 81 ms to detect per image and 36 ms to match a pair, ORB 6 ms and 55 ms.
+  /// 640x360 (Pavilion), 1000 features: SIFT 43 ms to detect per image, ORB 5 ms; matching a pair
+  /// 3-4 ms either way. ORB's matches registered fewer frames and gave a worse ATE on every real
+  /// set but 7-Scenes (docs/benchmarks.md).
   FeatureKind kind = FeatureKind::kSift;
   /// Most features kept per image, the strongest first (SIFT: by contrast response; ORB: by
-  /// Harris score). In [1, 100000].
-  int max_features = 2000;
+  /// Harris score). Matching costs its square. 1000 rather than 2000 lowered the initialiser's
+  /// ATE on 7-Scenes, Pavilion and fountain-P11 and left KITTI, templeRing and templeSparseRing
+  /// (which has fewer) unchanged (docs/benchmarks.md). In [1, 100000].
+  int max_features = 1000;
+  /// Features are detected on the image resized by this factor and their pixels mapped back
+  /// (unitless; 1: full resolution). SIFT's scale space starts at twice the image size, so 0.5
+  /// starts it at full size: about 4x faster, without SIFT's finest scale, and a quarter of the
+  /// features on Pavilion; at 0.5 the initialiser registered 8 of templeSparseRing's 16 stills
+  /// and 56 of Pavilion's 100 frames (0.75: 13 of 16). In (0, 1].
+  double detection_scale = 1.0;
   /// Lowe's ratio: a match is kept when its descriptor distance is below this fraction of the
   /// distance to the second nearest descriptor (unitless; smaller is stricter: fewer, surer
   /// matches). In (0, 1].

@@ -236,7 +236,9 @@ struct FeatureTrackBuilder::State {
     const bool broken =
         frame > 0 && (previous_live == 0 ||
                       stats.back().klt_tracked < options.min_tracked_fraction * previous_live);
-    if (broken && last_matching_frame < frame - 1) makeMatchingFrame(frame - 1, previous_image);
+    if (broken && options.match_frame_before_break && last_matching_frame < frame - 1) {
+      makeMatchingFrame(frame - 1, previous_image);
+    }
     if (frame % options.match_interval == 0 || broken) makeMatchingFrame(frame, image);
     previous_image = image.clone();
     if (numFrames() > options.exhaustive_max_frames) all_matching.clear();  // Too long now.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
@@ -57,6 +58,7 @@ void PointInitialiserOptions::validate() const {
   require(global_ba_growth > 1.0 && global_ba_growth < 1e6, "global_ba_growth", global_ba_growth,
           "finite and > 1");
   require(max_registration_trials >= 1, "max_registration_trials", max_registration_trials, ">= 1");
+  require(tracking_threads >= 0, "tracking_threads", tracking_threads, ">= 0");
   require(fallback_min_inliers >= 4, "fallback_min_inliers", fallback_min_inliers, ">= 4");
   require(max_models >= 1, "max_models", max_models, ">= 1");
   require(min_merge_points >= 3, "min_merge_points", min_merge_points, ">= 3");
@@ -69,6 +71,20 @@ int PointInitialisation::registeredFrames() const {
 }
 
 namespace {
+
+// OpenCV's thread count for one scope, restored after: cv::setNumThreads is process-wide.
+class TrackingThreads {
+ public:
+  explicit TrackingThreads(int threads) : previous_(cv::getNumThreads()) {
+    cv::setNumThreads(threads > 0 ? threads : -1);
+  }
+  ~TrackingThreads() { cv::setNumThreads(previous_); }
+  TrackingThreads(const TrackingThreads&) = delete;
+  TrackingThreads& operator=(const TrackingThreads&) = delete;
+
+ private:
+  int previous_;
+};
 
 // A point of a model: its position and the registered frames whose observation it uses. A
 // removed point keeps its slot (track -1) so that indices stay valid.
@@ -745,6 +761,7 @@ struct PointInitialiser::State {
         << "frame " << frames_added << " is " << image.cols << "x" << image.rows
         << " but the camera is " << camera->width() << "x" << camera->height();
     const Clock::time_point start = Clock::now();
+    const TrackingThreads threads(options.tracking_threads);
     const cv::Mat undistorted = undistorter.undistort(image);
     out.seconds.undistort += secondsSince(start);
     builder.addFrame(undistorted);
@@ -754,7 +771,10 @@ struct PointInitialiser::State {
 
   PointInitialisation finish() {
     const Clock::time_point start = Clock::now();
-    tracks = builder.finish();
+    {
+      const TrackingThreads threads(options.tracking_threads);
+      tracks = builder.finish();
+    }
     out.num_tracks = static_cast<int>(tracks.tracks.size());
     out.track_stats = tracks.frames;
     for (const FeatureTrackFrameStats& s : tracks.frames) {
@@ -774,6 +794,12 @@ struct PointInitialiser::State {
     return std::move(out);
   }
 };
+
+double InitialiserTimes::tracksMsPerVgaFrame(int frames, int width, int height) const {
+  if (frames <= 0 || width <= 0 || height <= 0) return 0.0;
+  return 1e3 * (undistort + klt + matching) / frames * (640.0 * 480.0) /
+         (static_cast<double>(width) * height);
+}
 
 PointInitialiser::PointInitialiser(const Camera& camera, const PointInitialiserOptions& options)
     : state_(std::make_unique<State>(camera, options)) {}

@@ -110,6 +110,10 @@ struct PointInitialiserOptions {
   /// Fewest tracks two models must both have triangulated to be merged by them, and fewest
   /// points each must see in a shared frame to be merged by its poses instead (count). >= 3.
   int min_merge_points = 20;
+  /// OpenCV threads while the tracks are built (count; 0: OpenCV's default, every core). One by
+  /// default: issue 13 budgets tracking per core, and two threads gain about a quarter of the
+  /// wall time of SIFT detection for half again its processor time. >= 0.
+  int tracking_threads = 1;
   /// Throws InvalidOptions naming the first field outside its range (also of the nested ones).
   void validate() const;
 
@@ -169,6 +173,9 @@ struct InitialiserBundleAdjustment {
 struct InitialiserTimes {
   double undistort = 0.0, klt = 0.0, matching = 0.0, pair_search = 0.0, registration = 0.0,
          triangulation = 0.0, local_ba = 0.0, global_ba = 0.0, merge = 0.0, total = 0.0;
+  /// Undistortion and tracks per frame, scaled to a 640x480 frame by the pixel count (ms): the
+  /// tracking budget of issue 13 (50 ms on one core, tracking_threads 1) in any image size.
+  double tracksMsPerVgaFrame(int frames, int width, int height) const;
 };
 
 /// What the initialiser made of the sequence.

@@ -10,6 +10,14 @@
 //           curves in one BA);
 //   colmap  COLMAP's feature_extractor (the set's fixed intrinsics, one camera), sequential
 //           matcher, mapper and model_converter, when `colmap` is on PATH.
+// curves and hybrid run once per start of --starts (issue 14's diagnosis): init (no initial
+// poses: the point initialiser's), truth (the ground truth at the images), noise (the truth with
+// every pose perturbed on its own, once per seed of --noise-seeds: a world-frame shift of
+// --noise-spacing-fraction of the median distance between consecutive cameras and a rotation of
+// --noise-rotation-deg, both per axis, Gaussian) and colmap (COLMAP's poses, which runs COLMAP
+// first). Each such row also holds the start's own ATE at the same keyframes (the run's
+// report.json) and refined / start; the summary prints them per set and start, with the spread
+// over the noise seeds, beside issue 14's targets.
 // curvesfm runs as a subprocess (--curvesfm, default the one built beside this bench); a variant
 // whose flags the executable does not list in its --help is skipped with a note, so the table
 // can name flags that a later curvesfm adds. Every trajectory (init: every registered frame;
@@ -32,6 +40,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -82,6 +91,7 @@ struct Variant {
 };
 
 const std::vector<std::string> kVariantNames = {"init", "curves", "hybrid", "colmap"};
+const std::vector<std::string> kStartNames = {"init", "truth", "noise", "colmap"};
 
 struct BenchOptions {
   std::string data = "../shared/data";  ///< Folder holding the sets of kSets (from the repo root).
@@ -92,12 +102,25 @@ struct BenchOptions {
   std::string hybrid_flags = "--ba-points true";      ///< Extra flags of the hybrid variant.
   int max_frames = 0;  ///< Frame cap for every set (0: each set's own cap).
   int threads = 2;     ///< Threads for every solver flag curvesfm lists and for COLMAP.
+  std::vector<std::string> starts = {"init"};      ///< Starts of the curves and hybrid variants.
+  std::vector<int> noise_seeds = {1, 2, 3, 4, 5};  ///< One noise start per seed.
+  /// Shift per axis of a noise start, as a fraction of the median camera spacing (unitless).
+  double noise_spacing_fraction = 0.01;
+  double noise_rotation_deg = 0.1;  ///< Rotation per axis of a noise start (deg).
+};
+
+/// Where the curve pipeline's poses start: a --starts name and, for noise, its seed.
+struct Start {
+  std::string kind = "init";
+  int seed = 0;
+  std::string label() const { return kind == "noise" ? "noise" + std::to_string(seed) : kind; }
 };
 
 /// One row of the table: a set through one variant.
 struct Row {
   std::string set;
   std::string variant;
+  std::string start;          ///< Start label of curves and hybrid rows; empty for the others.
   std::string status = "ok";  ///< ok, failed or skipped.
   std::string note;           ///< Why it failed or was skipped; caps and flags otherwise.
   int frames = 0;             ///< Images of the set after caps.
@@ -105,6 +128,8 @@ struct Row {
   int evaluated = 0;          ///< Poses matched to the ground truth (run: keyframes).
   ErrorStatistics ate;        ///< Sim(3) ATE (ground-truth unit).
   ErrorStatistics rpe;        ///< RPE translation between consecutive evaluated poses.
+  /// The start's ATE rmse at the evaluated keyframes (the run's report.json; NaN without).
+  double start_ate = std::nan("");
   // Wall times (s); NaN where the variant has no such stage.
   double tracks_s = std::nan("");
   /// Tracks per frame scaled to 640x480 (ms; one core: curvesfm's tracking_threads 1).
@@ -257,11 +282,15 @@ std::vector<std::string> sequenceFlags(const RealSet& set, const ImageSequenceOp
   return flags;
 }
 
+/// Runs a curvesfm variant; `init_poses` (a TUM file) is the start of a run, empty for the
+/// initialiser's.
 void runCurvesfm(const BenchOptions& options, const Variant& variant, const RealSet& set,
                  const ImageSequence& sequence, const ImageSequenceOptions& sequence_options,
-                 FlagCatalogue* catalogue, const fs::path& dir, Row* row) {
+                 const std::string& init_poses, FlagCatalogue* catalogue, const fs::path& dir,
+                 Row* row) {
   std::vector<std::string> argv = {options.curvesfm, variant.command, "--dataset",
                                    sequence.dir,     "--out",         dir.string()};
+  if (!init_poses.empty()) argv.insert(argv.end(), {"--init-poses", init_poses});
   const std::vector<std::string> unknown = catalogue->unknown(variant.command, variant.flags);
   if (!unknown.empty()) {
     row->status = "skipped";
@@ -298,6 +327,9 @@ void runCurvesfm(const BenchOptions& options, const Variant& variant, const Real
   } else {
     readInitialiserTimes(report.value("initialiser", nlohmann::json()), row);
     readPipelineTimes(report, row);
+    const nlohmann::json ate = report.value("ate", nlohmann::json::object());
+    if (ate.is_object() && ate.contains("initial_m"))
+      row->start_ate = number(ate["initial_m"], "rmse");
   }
   if (r.exit_code != 0) {
     row->status = "failed";
@@ -305,6 +337,75 @@ void runCurvesfm(const BenchOptions& options, const Variant& variant, const Real
     return;
   }
   evaluate(readTrajectory((dir / "trajectory.txt").string()), sequence, dir, row);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Starts.
+
+/// The ground-truth poses at the sequence's images (by timestamp within 0.02 s).
+std::vector<StampedPose> truthAtImages(const ImageSequence& sequence) {
+  std::vector<StampedPose> poses;
+  for (const SequenceImage& image : sequence.images) {
+    const StampedPose* nearest = nullptr;
+    for (const StampedPose& p : sequence.ground_truth) {
+      if (!nearest || std::abs(p.timestamp - image.timestamp) <
+                          std::abs(nearest->timestamp - image.timestamp)) {
+        nearest = &p;
+      }
+    }
+    if (nearest && std::abs(nearest->timestamp - image.timestamp) <= 0.02) {
+      poses.push_back({image.timestamp, nearest->world_from_cam});
+    }
+  }
+  return poses;
+}
+
+/// Median distance between consecutive camera centres.
+double medianSpacing(const std::vector<StampedPose>& poses) {
+  std::vector<double> spacing;
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    spacing.push_back(
+        (poses[i].world_from_cam.translation() - poses[i - 1].world_from_cam.translation()).norm());
+  }
+  if (spacing.empty()) return 0.0;
+  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
+  return spacing[spacing.size() / 2];
+}
+
+/// `truth` with every pose perturbed on its own: a world-frame shift of the camera centre and a
+/// world-frame rotation, Gaussian per axis (Pose3::retract).
+std::vector<StampedPose> noisyStart(const std::vector<StampedPose>& truth,
+                                    const BenchOptions& options, int seed) {
+  std::mt19937 rng(static_cast<std::uint32_t>(seed));
+  std::normal_distribution<double> rotation(0.0, options.noise_rotation_deg * M_PI / 180.0);
+  std::normal_distribution<double> shift(0.0,
+                                         options.noise_spacing_fraction * medianSpacing(truth));
+  std::vector<StampedPose> noisy;
+  for (const StampedPose& p : truth) {
+    Vector6d delta;
+    for (int k = 0; k < 3; ++k) delta(k) = rotation(rng);
+    for (int k = 3; k < 6; ++k) delta(k) = shift(rng);
+    noisy.push_back({p.timestamp, p.world_from_cam.retract(delta)});
+  }
+  return noisy;
+}
+
+/// The TUM file of `start` for one set (written on first use), or empty for the initialiser's
+/// start; throws when COLMAP's start is asked for and COLMAP gave no poses.
+std::string startPosesFile(const Start& start, const ImageSequence& sequence,
+                           const std::vector<StampedPose>& colmap_poses,
+                           const BenchOptions& options, const fs::path& set_dir) {
+  if (start.kind == "init") return "";
+  const fs::path path = set_dir / ("start_" + start.label() + ".txt");
+  std::vector<StampedPose> poses;
+  if (start.kind == "truth") poses = truthAtImages(sequence);
+  if (start.kind == "noise") poses = noisyStart(truthAtImages(sequence), options, start.seed);
+  if (start.kind == "colmap") {
+    if (colmap_poses.empty()) throw Error("COLMAP gave no poses to start from");
+    poses = colmap_poses;
+  }
+  writeTrajectory(path.string(), poses);
+  return path.string();
 }
 
 // COLMAP's parameters for our camera: pixel centres at 0.5 there, at 0 here.
@@ -342,8 +443,10 @@ bool colmapStep(const std::string& colmap, const std::string& step,
   return false;
 }
 
+/// Runs COLMAP; `poses` receives the largest model's poses (empty when it failed).
 void runColmap(const BenchOptions& options, const std::string& colmap,
-               const ImageSequence& sequence, const fs::path& dir, Row* row) {
+               const ImageSequence& sequence, const fs::path& dir, Row* row,
+               std::vector<StampedPose>* poses) {
   const Clock::time_point start = Clock::now();
   const fs::path image_dir = fs::path(sequence.images.front().image_path).parent_path();
   std::ofstream list(dir / "image_list.txt");
@@ -444,6 +547,7 @@ void runColmap(const BenchOptions& options, const std::string& colmap,
     return;
   }
   evaluate(best, sequence, dir, row);
+  *poses = std::move(best);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -467,15 +571,17 @@ bool evaluated(const Row& r) { return r.status == "ok"; }
 void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
   std::ofstream out(path);
   if (!out) throw IoError(path.string(), "cannot open for writing");
-  out << "set,variant,status,frames,registered,evaluated,ate_rmse,ate_mean,ate_median,"
+  out << "set,variant,start,status,frames,registered,evaluated,start_ate_rmse,ate_rmse,ate_mean,"
+         "ate_median,"
          "rpe_translation_rmse,tracks_s,tracks_ms_per_640x480_frame,init_s,curves_s,local_ba_s,"
          "global_ba_s,extraction_s,"
          "matching_s,mapping_s,total_s,note\n";
   for (const Row& r : rows) {
     const bool ok = evaluated(r);
     const double nan = std::nan("");
-    out << r.set << "," << r.variant << "," << r.status << "," << r.frames << "," << r.registered
-        << "," << r.evaluated << "," << formatNumber(ok ? r.ate.rmse : nan, "%.9g") << ","
+    out << r.set << "," << r.variant << "," << r.start << "," << r.status << "," << r.frames << ","
+        << r.registered << "," << r.evaluated << "," << formatNumber(r.start_ate, "%.9g") << ","
+        << formatNumber(ok ? r.ate.rmse : nan, "%.9g") << ","
         << formatNumber(ok ? r.ate.mean : nan, "%.9g") << ","
         << formatNumber(ok ? r.ate.median : nan, "%.9g") << ","
         << formatNumber(ok && r.rpe.count > 0 ? r.rpe.rmse : nan, "%.9g") << ","
@@ -499,13 +605,14 @@ std::string markdownRow(const Row& r) {
   std::string note = r.note;
   std::replace(note.begin(), note.end(), '|', '/');
   std::ostringstream line;
-  line << "| " << r.set << " | " << r.variant << " | "
+  line << "| " << r.set << " | " << r.variant << " | " << r.start << " | "
        << (r.status == "skipped" ? "skipped"
                                  : std::to_string(r.registered) + " / " + std::to_string(r.frames))
-       << " | " << (ok ? std::to_string(r.evaluated) : "") << " | "
-       << formatNumber(ok ? r.ate.rmse : nan) << " | " << formatNumber(ok ? r.ate.mean : nan)
-       << " | " << formatNumber(ok ? r.ate.median : nan) << " | "
-       << formatNumber(ok && r.rpe.count > 0 ? r.rpe.rmse : nan) << " | "
+       << " | " << (ok ? std::to_string(r.evaluated) : "") << " | " << formatNumber(r.start_ate)
+       << " | " << formatNumber(ok ? r.ate.rmse : nan) << " | "
+       << formatNumber(ok ? r.ate.rmse / r.start_ate : nan, "%.3f") << " | "
+       << formatNumber(ok ? r.ate.mean : nan) << " | " << formatNumber(ok ? r.ate.median : nan)
+       << " | " << formatNumber(ok && r.rpe.count > 0 ? r.rpe.rmse : nan) << " | "
        << formatNumber(r.tracks_s, "%.1f") << " | " << formatNumber(r.tracks_ms, "%.1f") << " | "
        << formatNumber(r.init_s, "%.1f") << " | " << formatNumber(r.curves_s, "%.1f") << " | "
        << formatNumber(r.local_ba_s, "%.1f") << " | " << formatNumber(r.global_ba_s, "%.1f")
@@ -516,25 +623,71 @@ std::string markdownRow(const Row& r) {
 
 std::string markdownTable(const std::vector<Row>& rows) {
   std::ostringstream out;
-  out << "| set | variant | registered | evaluated | ATE rmse | ATE mean | ATE median | RPE t rmse "
+  out << "| set | variant | start | registered | evaluated | start ATE | ATE rmse | ATE / start "
+         "| ATE mean | ATE median | RPE t rmse "
          "| tracks s | tracks ms per 640x480 frame, one core | init s | curves s | local BA s | "
          "global BA s | COLMAP extract / match / "
          "map s | total s | note |\n"
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) out << markdownRow(r) << "\n";
   return out.str();
 }
 
 void printProgress(const Row& r, int done, int total) {
   if (r.status == "ok") {
-    std::printf("[%d/%d] %s %s: %d/%d registered, %d evaluated, ATE rmse %.4g, %.1f s\n", done,
-                total, r.set.c_str(), r.variant.c_str(), r.registered, r.frames, r.evaluated,
-                r.ate.rmse, r.total_s);
+    std::printf("[%d/%d] %s %s%s: %d/%d registered, %d evaluated, ATE rmse %.4g", done, total,
+                r.set.c_str(), r.variant.c_str(),
+                r.start.empty() ? "" : (" from " + r.start).c_str(), r.registered, r.frames,
+                r.evaluated, r.ate.rmse);
+    if (!std::isnan(r.start_ate)) std::printf(" (start %.4g)", r.start_ate);
+    std::printf(", %.1f s\n", r.total_s);
   } else {
     std::printf("[%d/%d] %s %s: %s: %s\n", done, total, r.set.c_str(), r.variant.c_str(),
                 r.status.c_str(), r.note.c_str());
   }
   std::fflush(stdout);
+}
+
+// Issue 14's targets for refined / start ATE per start; truth is judged against COLMAP's ATE.
+double startTarget(const std::string& kind) {
+  if (kind == "noise") return 0.5;
+  if (kind == "init" || kind == "colmap") return 0.8;
+  return std::nan("");
+}
+
+/// Per set, curve variant and start kind: refined / start ATE (noise: median and range over the
+/// seeds), and the start exactly at the truth against COLMAP's ATE, beside issue 14's targets.
+void printStartSummary(const std::vector<Row>& rows) {
+  std::map<std::string, double> colmap_ate;
+  for (const Row& r : rows) {
+    if (r.variant == "colmap" && r.status == "ok") colmap_ate[r.set] = r.ate.rmse;
+  }
+  std::map<std::string, std::vector<double>> ratios;  // "set variant kind" -> ratios
+  for (const Row& r : rows) {
+    if (r.start.empty() || r.status != "ok") continue;
+    const std::string kind = r.start.rfind("noise", 0) == 0 ? "noise" : r.start;
+    const std::string key = r.set + " " + r.variant + " " + kind;
+    if (kind == "truth") {
+      const auto colmap = colmap_ate.find(r.set);
+      const double reference = colmap == colmap_ate.end() ? std::nan("") : colmap->second;
+      std::printf("start %s: drift ATE %.4g, %.2f x COLMAP's %.4g (target <= 0.5)\n", key.c_str(),
+                  r.ate.rmse, r.ate.rmse / reference, reference);
+      continue;
+    }
+    if (r.start_ate > 0.0) ratios[key].push_back(r.ate.rmse / r.start_ate);
+  }
+  for (auto& [key, values] : ratios) {
+    std::sort(values.begin(), values.end());
+    const std::string kind = key.substr(key.rfind(' ') + 1);
+    const double target = startTarget(kind);
+    const int met = static_cast<int>(
+        std::count_if(values.begin(), values.end(), [&](double v) { return v <= target; }));
+    std::printf(
+        "start %s: refined / start ATE median %.3f, range %.3f-%.3f over %zu run(s); %d "
+        "of %zu <= %.1f\n",
+        key.c_str(), values[values.size() / 2], values.front(), values.back(), values.size(), met,
+        values.size(), target);
+  }
 }
 
 void printSummary(const std::vector<Row>& rows, const std::vector<std::string>& variants) {
@@ -559,9 +712,35 @@ void printSummary(const std::vector<Row>& rows, const std::vector<std::string>& 
 
 // ---------------------------------------------------------------------------------------------
 
+/// The starts a variant runs from: every --starts entry (noise once per seed) for the curve
+/// pipeline's variants, one for the others.
+std::vector<Start> startsOf(const Variant& variant, const BenchOptions& options) {
+  if (variant.command != "run") return {Start{}};
+  std::vector<Start> starts;
+  for (const std::string& kind : options.starts) {
+    if (kind != "noise") starts.push_back({kind, 0});
+    if (kind == "noise") {
+      for (int seed : options.noise_seeds) starts.push_back({kind, seed});
+    }
+  }
+  return starts;
+}
+
+bool wantsColmapStart(const BenchOptions& options) {
+  return std::find(options.starts.begin(), options.starts.end(), "colmap") != options.starts.end();
+}
+
+/// The variants to run, in order; COLMAP first when a curve run starts from its poses (and
+/// added when --variants left it out).
 std::vector<Variant> selectedVariants(const BenchOptions& options) {
   std::vector<Variant> variants;
+  const bool runs_curves =
+      std::any_of(options.variants.begin(), options.variants.end(),
+                  [](const std::string& name) { return name == "curves" || name == "hybrid"; });
+  const bool colmap_first = wantsColmapStart(options) && runs_curves;
+  if (colmap_first) variants.push_back({"colmap", "", {}});
   for (const std::string& name : options.variants) {
+    if (name == "colmap" && colmap_first) continue;
     if (name == "init") variants.push_back({name, "init", {}});
     if (name == "curves") variants.push_back({name, "run", {}});
     if (name == "hybrid") variants.push_back({name, "run", splitWords(options.hybrid_flags)});
@@ -601,7 +780,11 @@ int run(const BenchOptions& options, const std::string& command) {
               colmap.empty() ? "not on PATH" : colmap.c_str());
 
   std::vector<Row> rows;
-  const int total = static_cast<int>(sets.size() * variants.size());
+  int rows_per_set = 0;
+  for (const Variant& variant : variants) {
+    rows_per_set += static_cast<int>(startsOf(variant, options).size());
+  }
+  const int total = static_cast<int>(sets.size()) * rows_per_set;
   for (const RealSet& set : sets) {
     ImageSequenceOptions sequence_options;
     sequence_options.camera = set.camera;
@@ -627,44 +810,53 @@ int run(const BenchOptions& options, const std::string& command) {
       std::printf("# skipped %s: %s\n", set.name.c_str(), e.what());
       continue;
     }
+    std::vector<StampedPose> colmap_poses;
     for (const Variant& variant : variants) {
-      Row row;
-      row.set = set.name;
-      row.variant = variant.name;
-      row.frames = static_cast<int>(sequence.images.size());
-      const fs::path dir = set_dir / variant.name;
-      fs::remove_all(dir);
-      fs::create_directories(dir);
-      std::printf("[%zu/%d] %s %s: running\n", rows.size() + 1, total, set.name.c_str(),
-                  variant.name.c_str());
-      std::fflush(stdout);
-      try {
-        if (variant.name == "colmap") {
-          if (colmap.empty()) {
-            row.status = "skipped";
-            row.note = "colmap is not on PATH";
+      for (const Start& start : startsOf(variant, options)) {
+        Row row;
+        row.set = set.name;
+        row.variant = variant.name;
+        if (variant.command == "run") row.start = start.label();
+        row.frames = static_cast<int>(sequence.images.size());
+        const fs::path dir =
+            set_dir / (start.kind == "init" ? variant.name : variant.name + "_" + start.label());
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+        std::printf("[%zu/%d] %s %s%s: running\n", rows.size() + 1, total, set.name.c_str(),
+                    variant.name.c_str(), row.start.empty() ? "" : (" from " + row.start).c_str());
+        std::fflush(stdout);
+        try {
+          if (variant.name == "colmap") {
+            if (colmap.empty()) {
+              row.status = "skipped";
+              row.note = "colmap is not on PATH";
+            } else {
+              runColmap(options, colmap, sequence, dir, &row, &colmap_poses);
+            }
           } else {
-            runColmap(options, colmap, sequence, dir, &row);
+            const std::string init_poses =
+                startPosesFile(start, sequence, colmap_poses, options, set_dir);
+            runCurvesfm(options, variant, set, sequence, sequence_options, init_poses, &catalogue,
+                        dir, &row);
           }
-        } else {
-          runCurvesfm(options, variant, set, sequence, sequence_options, &catalogue, dir, &row);
+        } catch (const Error& e) {
+          row.status = "failed";
+          row.note = e.what();
         }
-      } catch (const Error& e) {
-        row.status = "failed";
-        row.note = e.what();
-      }
-      if (row.status == "ok") {
-        // The caps and flags that make this row differ from a plain run, then the run's note.
-        std::vector<std::string> parts;
-        for (const std::string& part : {set_note, joinWords(variant.flags), row.note}) {
-          if (!part.empty()) parts.push_back(part);
+        if (row.status == "ok") {
+          // The caps and flags that make this row differ from a plain run, then the run's note.
+          std::vector<std::string> parts;
+          for (const std::string& part : {set_note, joinWords(variant.flags), row.note}) {
+            if (!part.empty()) parts.push_back(part);
+          }
+          row.note = joinWords(parts, "; ");
         }
-        row.note = joinWords(parts, "; ");
+        rows.push_back(row);
+        printProgress(row, static_cast<int>(rows.size()), total);
+        // Rewritten after every row, so that a long bench stopped half-way keeps what it
+        // measured.
+        writeCsv(rows, out / "real_bench.csv");
       }
-      rows.push_back(row);
-      printProgress(row, static_cast<int>(rows.size()), total);
-      // Rewritten after every row, so that a long bench stopped half-way keeps what it measured.
-      writeCsv(rows, out / "real_bench.csv");
     }
   }
   const std::string table = markdownTable(rows);
@@ -679,6 +871,7 @@ int run(const BenchOptions& options, const std::string& command) {
   }
   std::printf("\n%s\n", table.c_str());
   printSummary(rows, options.variants);
+  printStartSummary(rows);
   bench::print("total_seconds", bench::secondsSince(start));
   bench::printText("outputs", (out / "{real_bench.csv,real_bench.md}").string());
   drawFiguresIfPossible({"real-bench", out.string()});
@@ -737,6 +930,43 @@ int main(int argc, char** argv) {
   app.add_option("--max-frames", options.max_frames,
                  "At most this many frames of every set (0: each set's own cap)")
       ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  app.add_option_function<std::string>(
+         "--starts",
+         [&options](const std::string& list) {
+           options.starts = curvesfm::bench::splitAtCommas(list, "--starts");
+           for (const std::string& name : options.starts) {
+             if (std::find(curvesfm::kStartNames.begin(), curvesfm::kStartNames.end(), name) ==
+                 curvesfm::kStartNames.end()) {
+               throw CLI::ValidationError(
+                   "--starts", "'" + name + "' is not one of init, truth, noise, colmap");
+             }
+           }
+         },
+         "Comma-separated starts of the curves and hybrid runs: init (the point initialiser), "
+         "truth, noise (the truth perturbed, per --noise-seeds), colmap (COLMAP's poses)")
+      ->default_str("init");
+  app.add_option_function<std::string>(
+         "--noise-seeds",
+         [&options](const std::string& list) {
+           options.noise_seeds.clear();
+           for (const std::string& word : curvesfm::bench::splitAtCommas(list, "--noise-seeds")) {
+             try {
+               options.noise_seeds.push_back(std::stoi(word));
+             } catch (const std::exception&) {
+               throw CLI::ValidationError("--noise-seeds", "'" + word + "' is not an integer");
+             }
+           }
+         },
+         "Comma-separated seeds, one noise start each")
+      ->default_str("1,2,3,4,5");
+  app.add_option("--noise-spacing-fraction", options.noise_spacing_fraction,
+                 "Noise start: camera shift per axis as a fraction of the median camera spacing")
+      ->check(CLI::Range(0.0, 10.0))
+      ->capture_default_str();
+  app.add_option("--noise-rotation-deg", options.noise_rotation_deg,
+                 "Noise start: rotation per axis (deg)")
+      ->check(CLI::Range(0.0, 90.0))
       ->capture_default_str();
   app.add_option("--threads", options.threads, "Threads of every solver and of COLMAP")
       ->check(CLI::Range(1, 64))

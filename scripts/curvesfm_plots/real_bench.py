@@ -1,6 +1,8 @@
 """`real-bench`: the figures of benchmarks/real_bench from what it writes into its output folder:
-real_bench.csv (one row per set and variant), SET/groundtruth.txt and
-SET/VARIANT/aligned_trajectory.txt (TUM, the estimate after its Sim(3) alignment).
+real_bench.csv (one row per set, variant and start), SET/groundtruth.txt and
+SET/RUN/aligned_trajectory.txt (TUM, the estimate after its Sim(3) alignment), RUN being the
+variant, or VARIANT_START for a curve run from another start than the initialiser's (the bar
+and line labels too).
 
   ate_by_set.png       ATE rmse per set, one bar per variant (log scale: the sets' units and
                        sizes differ by orders of magnitude); a variant that failed or was
@@ -24,6 +26,9 @@ def draw(out_dir):
         raise InputError("%s: no rows: nothing to draw" % path)
     for r in rows:
         r["ate_rmse"] = number(r, "ate_rmse", path)
+        start = r.get("start", "")
+        if start not in ("", "init"):
+            r["variant"] = "%s_%s" % (r["variant"], start)
     sets = []
     for r in rows:
         if r["set"] not in sets:

@@ -312,6 +312,10 @@ RunCommand::RunCommand(CLI::App* app) {
   c->add_option("--max-dt", max_dt_,
                 "Largest time difference between an image and its initial pose (s)")
       ->capture_default_str();
+  c->add_option("--points-at-given-poses", points_at_given_poses_,
+                "With given initial poses, triangulate the initialiser's tracks at them (points "
+                "for the depth ranges and --ba-points)")
+      ->capture_default_str();
   c->add_flag("--overlays", overlays_,
               "Write OUT/overlays/NNNNNN.png: the final curves drawn on keyframe NNNNNN");
   c->add_option("--export-samples", export_samples_per_segment_,
@@ -337,6 +341,7 @@ nlohmann::json RunCommand::runOptionsJson() const {
   nlohmann::json options = table_.toJson();
   options["export_samples_per_segment"] = export_samples_per_segment_;
   options["max_dt"] = max_dt_;
+  options["points_at_given_poses"] = points_at_given_poses_;
   return options;
 }
 
@@ -347,6 +352,14 @@ RunInput RunCommand::loadInput() const {
       readInitialPoses(init_poses_path_, input.sequence, &input.init_poses_source);
   if (!poses.empty()) {
     input.frames = framesWithPoses(input.sequence, poses, max_dt_, input.init_poses_source);
+    if (points_at_given_poses_ && input.frames.size() >= 2) {
+      std::printf("run: triangulating the tracks of the %zu images at the given poses\n",
+                  input.sequence.images.size());
+      input.initialisation = triangulateAtPoses(input.sequence, input.frames, initialiser_);
+      input.sightings = initialisedSightings(*input.initialisation);
+      std::printf("run: %zu points from %d tracks at the given poses\n",
+                  input.initialisation->points.size(), input.initialisation->num_tracks);
+    }
     return input;
   }
   std::printf(

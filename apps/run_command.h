@@ -49,6 +49,9 @@ class RunCommand {
   int export_samples_per_segment_ = 20;
   /// Largest |t_image - t_pose| of an image matched to an initial pose (s).
   double max_dt_ = 0.02;
+  /// With given initial poses, the initialiser's tracks are triangulated at them: points for the
+  /// keyframes' depth ranges and for --ba-points, as the initialiser's own run has.
+  bool points_at_given_poses_ = true;
   ImageSequenceOptions sequence_;
   PointInitialiserOptions initialiser_;
   PipelineOptions options_;

@@ -59,6 +59,20 @@ std::map<std::string, BaTotals> baTotals(const PointInitialisation& result) {
   return totals;
 }
 
+// Feeds every image of `sequence` to `initialiser`, printing progress.
+void trackSequence(const ImageSequence& sequence, PointInitialiser* initialiser,
+                   Clock::time_point start) {
+  const int frames = static_cast<int>(sequence.images.size());
+  const int every = std::max(1, frames / 10);
+  for (int i = 0; i < frames; ++i) {
+    initialiser->addFrame(loadCameraImage(sequence.images[i].image_path, sequence.camera));
+    if ((i + 1) % every == 0 || i + 1 == frames) {
+      std::printf("init: tracked %d/%d frames (%.1f s)\n", i + 1, frames, secondsSince(start));
+      std::fflush(stdout);
+    }
+  }
+}
+
 }  // namespace
 
 PointInitialisation initialiseSequence(const ImageSequence& sequence,
@@ -67,13 +81,7 @@ PointInitialisation initialiseSequence(const ImageSequence& sequence,
   const int frames = static_cast<int>(sequence.images.size());
   const int every = std::max(1, frames / 10);
   const Clock::time_point start = Clock::now();
-  for (int i = 0; i < frames; ++i) {
-    initialiser.addFrame(loadCameraImage(sequence.images[i].image_path, sequence.camera));
-    if ((i + 1) % every == 0 || i + 1 == frames) {
-      std::printf("init: tracked %d/%d frames (%.1f s)\n", i + 1, frames, secondsSince(start));
-      std::fflush(stdout);
-    }
-  }
+  trackSequence(sequence, &initialiser, start);
   initialiser.setProgress([every, start](int model, int registered, int total, int points) {
     if (registered % every != 0 && registered != total) return;
     std::printf("init: model %d registered %d/%d frames, %d points (%.1f s)\n", model, registered,
@@ -81,6 +89,24 @@ PointInitialisation initialiseSequence(const ImageSequence& sequence,
     std::fflush(stdout);
   });
   return initialiser.finish();
+}
+
+PointInitialisation triangulateAtPoses(const ImageSequence& sequence,
+                                       const std::vector<DatasetFrame>& frames,
+                                       const PointInitialiserOptions& options) {
+  PointInitialiser initialiser(sequence.camera, options);
+  trackSequence(sequence, &initialiser, Clock::now());
+  std::map<std::string, Pose3> pose_of_image;
+  for (const DatasetFrame& frame : frames) {
+    pose_of_image.emplace(frame.image_path, frame.initial_cam_from_world);
+  }
+  std::vector<std::optional<Pose3>> poses;
+  for (const SequenceImage& image : sequence.images) {
+    const auto found = pose_of_image.find(image.image_path);
+    poses.push_back(found == pose_of_image.end() ? std::nullopt
+                                                 : std::optional<Pose3>(found->second));
+  }
+  return initialiser.finishAtPoses(poses);
 }
 
 std::vector<DatasetFrame> initialisedFrames(const ImageSequence& sequence,

@@ -23,6 +23,13 @@ PointInitialisation initialiseSequence(const ImageSequence& sequence,
 
 /// The registered frames with their images and poses, in sequence order: the frames `run` feeds
 /// to the curve pipeline.
+/// The initialiser's tracks of every image of `sequence`, triangulated at the poses of `frames`
+/// (PointInitialiser::finishAtPoses; an image is matched to its frame by path, and one without a
+/// frame keeps no pose). Prints progress as initialiseSequence.
+PointInitialisation triangulateAtPoses(const ImageSequence& sequence,
+                                       const std::vector<DatasetFrame>& frames,
+                                       const PointInitialiserOptions& options);
+
 std::vector<DatasetFrame> initialisedFrames(const ImageSequence& sequence,
                                             const PointInitialisation& result);
 

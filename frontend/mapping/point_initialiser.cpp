@@ -769,8 +769,8 @@ struct PointInitialiser::State {
     add_frame_seconds += secondsSince(start);
   }
 
-  PointInitialisation finish() {
-    const Clock::time_point start = Clock::now();
+  // Builds the tracks from the frames added (the first half of finish() and finishAtPoses()).
+  void buildTracks() {
     {
       const TrackingThreads threads(options.tracking_threads);
       tracks = builder.finish();
@@ -782,6 +782,31 @@ struct PointInitialiser::State {
       out.seconds.matching += s.match_seconds;
     }
     out.frames.assign(numFrames(), InitialisedFrame{});
+  }
+
+  PointInitialisation finishAtPoses(const std::vector<std::optional<Pose3>>& cam_from_world) {
+    CURVESFM_CHECK(static_cast<int>(cam_from_world.size()) == frames_added)
+        << "finishAtPoses: " << cam_from_world.size() << " poses for " << frames_added << " frames";
+    const Clock::time_point start = Clock::now();
+    buildTracks();
+    Model model(numFrames(), static_cast<int>(tracks.tracks.size()));
+    for (int f = 0; f < numFrames(); ++f) {
+      if (cam_from_world[f]) model.registerFrame(f, *cam_from_world[f]);
+    }
+    const Clock::time_point triangulation = Clock::now();
+    retriangulateAll(&model);
+    filterPoints(&model, allPoints(model));
+    out.seconds.triangulation += secondsSince(triangulation);
+    out.models = out.merged_models = model.registered() > 0 ? 1 : 0;
+    out.scale_convention = "the given poses' unit";
+    writeResult(model, {model}, std::vector<int>(numFrames(), 0));
+    out.seconds.total = add_frame_seconds + secondsSince(start);
+    return std::move(out);
+  }
+
+  PointInitialisation finish() {
+    const Clock::time_point start = Clock::now();
+    buildTracks();
     std::vector<Model> models = buildModels();
     if (!models.empty()) {
       std::vector<int> model_of_frame(numFrames(), -1);
@@ -809,6 +834,11 @@ PointInitialiser::~PointInitialiser() = default;
 void PointInitialiser::addFrame(const cv::Mat& image) { state_->addFrame(image); }
 
 PointInitialisation PointInitialiser::finish() { return state_->finish(); }
+
+PointInitialisation PointInitialiser::finishAtPoses(
+    const std::vector<std::optional<Pose3>>& cam_from_world) {
+  return state_->finishAtPoses(cam_from_world);
+}
 
 const Camera& PointInitialiser::undistortedCamera() const { return *state_->camera; }
 

@@ -210,6 +210,12 @@ class PointInitialiser {
   /// Reconstructs from the tracks. Never throws on hard data: failure and per-frame reasons say
   /// what could not be done.
   PointInitialisation finish();
+  /// Triangulates the tracks at known poses instead (cam_from_world per frame given, in the
+  /// poses' unit; a frame without one is left out), with the gates of finish() and no BA: the
+  /// points of a run that brings its own poses, for the keyframes' depth ranges and the hybrid
+  /// graph (COLMAP's point_triangulator does the same for a known model). Every posed frame is
+  /// "registered" with its pose unchanged. Call instead of finish(), once.
+  PointInitialisation finishAtPoses(const std::vector<std::optional<Pose3>>& cam_from_world);
   /// The pinhole camera of the undistorted images, which every result pixel refers to.
   const Camera& undistortedCamera() const;
   /// Called by finish() after every registered frame with (model, frames registered in it,

@@ -98,6 +98,62 @@ AteResult evaluateAte(const PipelineResult& r, const ImageSequence& d) {
   return ate;
 }
 
+// How far one stage moved the keyframe poses from the start (Sim(3)-aligned camera centres, pose
+// units), and their ATE against the ground truth then (NaN without one).
+struct StageMotion {
+  std::string name;
+  double moved_rmse = 0.0;
+  double ate_rmse = std::nan("");
+};
+
+std::vector<StageMotion> stageMotions(const PipelineResult& r, const ImageSequence& d) {
+  std::vector<StageMotion> motions;
+  if (r.keyframe_timestamps.size() < 3) return motions;
+  const TrajectoryEvaluationOptions options;  // Sim(3), 0.02 s.
+  const std::vector<StampedPose> start =
+      stampedPoses(r.keyframe_timestamps, r.keyframe_initial_cam_from_world);
+  for (const PoseStage& stage : r.pose_stages) {
+    const std::vector<StampedPose> poses =
+        stampedPoses(r.keyframe_timestamps, stage.keyframe_cam_from_world);
+    StageMotion m{stage.name};
+    try {
+      m.moved_rmse = compareTrajectories(poses, start, options, stage.name, "start").ate.rmse;
+      if (!d.ground_truth.empty()) {
+        m.ate_rmse =
+            compareTrajectories(poses, d.ground_truth, options, stage.name, d.ground_truth_source)
+                .ate.rmse;
+      }
+    } catch (const TrajectoryEvaluationError&) {
+      continue;  // The final ATE reports the problem.
+    }
+    motions.push_back(m);
+  }
+  return motions;
+}
+
+nlohmann::json stageMotionsJson(const std::vector<StageMotion>& motions, double scene_scale) {
+  nlohmann::json stages = nlohmann::json::array();
+  for (const StageMotion& m : motions) {
+    nlohmann::json stage;
+    stage["stage"] = m.name;
+    stage["moved_rmse"] = m.moved_rmse;
+    stage["moved_in_scene_scale"] = scene_scale > 0.0 ? m.moved_rmse / scene_scale : 0.0;
+    stage["ate_rmse"] = std::isnan(m.ate_rmse) ? nlohmann::json() : nlohmann::json(m.ate_rmse);
+    stages.push_back(stage);
+  }
+  return stages;
+}
+
+void printStageMotions(const std::vector<StageMotion>& motions) {
+  if (motions.empty()) return;
+  std::printf("poses moved from the start (Sim(3) rmse, pose units)");
+  for (const StageMotion& m : motions) {
+    std::printf("%s %s %.4g", &m == &motions.front() ? ":" : ",", m.name.c_str(), m.moved_rmse);
+    if (!std::isnan(m.ate_rmse)) std::printf(" (ATE %.4g)", m.ate_rmse);
+  }
+  std::printf("\n");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Output.
 
@@ -394,6 +450,7 @@ int RunCommand::run() const {
   feedFrames(&pipeline, input);
   const PipelineResult result = pipeline.finish();
   const AteResult ate = evaluateAte(result, d);
+  const std::vector<StageMotion> motions = stageMotions(result, d);
 
   writeTrajectory(joinPath(out_dir_, "trajectory.txt"),
                   stampedPoses(result.keyframe_timestamps, result.keyframe_cam_from_world));
@@ -446,10 +503,12 @@ int RunCommand::run() const {
        {"reassociation", reassociationToJson(result.reassociation)},
        {"final_samples", sampleCountsToJson(result.final_samples)},
        {"ate", ateToJson(ate)},
+       {"pose_stages", stageMotionsJson(motions, result.scene_scale)},
        {"total_seconds", seconds}});
 
   printSummary(input, result, seconds);
   printAte(ate, d.ground_truth_source);
+  printStageMotions(motions);
   std::printf(
       "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, report.json, "
       "config.yaml%s%s)\n",

@@ -263,6 +263,7 @@ struct Pipeline::Impl {
   int reassociate();
   std::vector<int> depthReferences(int k, const std::vector<EdgeChain>& chains) const;
   EpipolarDepthOptions depthOptions(int k) const;
+  PoseStage poseStage(const std::string& name) const;
   void initialiseCurves(int k, const std::vector<EdgeChain>& chains, KeyframeStats* stats);
   std::vector<OpenEnd> openEnds(int k) const;
   void addInitialCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
@@ -438,6 +439,21 @@ int Pipeline::Impl::reassociate() {
     }
   }
   return added;
+}
+
+// The keyframe poses now, in the unit of the poses given; a pose nothing moved is returned
+// exactly as given, without the grid's rounding.
+PoseStage Pipeline::Impl::poseStage(const std::string& name) const {
+  PoseStage stage{name, {}};
+  for (const Keyframe& keyframe : keyframes) {
+    const bool moved =
+        keyframe.cam_from_world.translation() != keyframe.initial_cam_from_world.translation() ||
+        keyframe.cam_from_world.rotation().coeffs() !=
+            keyframe.initial_cam_from_world.rotation().coeffs();
+    stage.keyframe_cam_from_world.push_back(moved ? scaledPose(keyframe.cam_from_world, unit())
+                                                  : keyframe.given_cam_from_world);
+  }
+  return stage;
 }
 
 // The depth range of keyframe k's epipolar search: from the points it sees when there are
@@ -720,9 +736,11 @@ PipelineResult Pipeline::finish() {
   CURVESFM_CHECK(!impl.finished) << "Pipeline::finish called twice";
   impl.finished = true;
   PipelineResult result;
+  result.pose_stages.push_back(impl.poseStage("incremental"));
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
     result.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
                                          /*refine_poses=*/true, &result.final_samples);
+    result.pose_stages.push_back(impl.poseStage("global_ba"));
     for (int r = 0; r < impl.options.reassociation_rounds; ++r) {
       ReassociationRound round;
       round.added_observations = impl.reassociate();
@@ -730,6 +748,7 @@ PipelineResult Pipeline::finish() {
       round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
                                           /*refine_poses=*/true, &result.final_samples);
       result.reassociation.push_back(std::move(round));
+      result.pose_stages.push_back(impl.poseStage("reassociation_" + std::to_string(r + 1)));
     }
   }
   // Back from the scene scale to the unit of the poses given.
@@ -737,15 +756,9 @@ PipelineResult Pipeline::finish() {
   result.scene_scale = impl.scene_scale;
   for (const Keyframe& keyframe : impl.keyframes) {
     result.keyframe_timestamps.push_back(keyframe.timestamp);
-    // A pose nothing moved is returned exactly as given, without the grid's rounding.
-    const bool moved =
-        keyframe.cam_from_world.translation() != keyframe.initial_cam_from_world.translation() ||
-        keyframe.cam_from_world.rotation().coeffs() !=
-            keyframe.initial_cam_from_world.rotation().coeffs();
-    result.keyframe_cam_from_world.push_back(moved ? scaledPose(keyframe.cam_from_world, unit)
-                                                   : keyframe.given_cam_from_world);
     result.keyframe_initial_cam_from_world.push_back(keyframe.given_cam_from_world);
   }
+  result.keyframe_cam_from_world = result.pose_stages.back().keyframe_cam_from_world;
   for (const PolyBezier& curve : impl.map.exportCurves(CurveSelection::kPromoted).curves) {
     result.curves.push_back(scaledCurve(curve, unit));
   }

@@ -211,6 +211,13 @@ struct ReassociationRound {
 };
 
 /// The result of a run: the refined keyframe trajectory and the global curve map.
+/// The keyframe poses after one stage of the run (issue 14's diagnosis: which stage moves them).
+struct PoseStage {
+  /// "incremental" (after the last keyframe's local BA), "global_ba", "reassociation_N".
+  std::string name;
+  std::vector<Pose3> keyframe_cam_from_world;  ///< Pose units, as keyframe_cam_from_world.
+};
+
 struct PipelineResult {
   std::vector<double> keyframe_timestamps;
   std::vector<Pose3> keyframe_cam_from_world;          ///< Refined.
@@ -226,6 +233,8 @@ struct PipelineResult {
   /// The hybrid graph's points after the last BA, world frame, pose units; empty unless
   /// ba.points and setPoints().
   std::vector<Eigen::Vector3d> points;
+  /// The keyframe poses after each stage, in order; the last is keyframe_cam_from_world.
+  std::vector<PoseStage> pose_stages;
 
   /// Wall time of the first global BA and of the re-association rounds' (s).
   double globalBaSeconds() const;

@@ -89,6 +89,20 @@ TEST(Pipeline, RefinesAPerturbedPlanarTrajectory) {
   // than the drifting start.
   EXPECT_LT(refined_ate, 0.5 * initial_ate)
       << "initial ATE " << initial_ate << " m, refined " << refined_ate << " m";
+  // The poses after every stage, in order: local BA held them, global BA and each re-association
+  // round moved them, the last stage is the result.
+  ASSERT_GE(result.pose_stages.size(), 2u);
+  EXPECT_EQ(result.pose_stages[0].name, "incremental");
+  EXPECT_EQ(result.pose_stages[1].name, "global_ba");
+  EXPECT_EQ(result.pose_stages.size(), 2 + result.reassociation.size());
+  for (std::size_t j = 0; j < scene.images.size(); ++j) {
+    EXPECT_EQ(cameraCentreDistance(result.pose_stages[0].keyframe_cam_from_world[j],
+                                   scene.initial_cam_from_world[j]),
+              0.0);
+    EXPECT_EQ(cameraCentreDistance(result.pose_stages.back().keyframe_cam_from_world[j],
+                                   result.keyframe_cam_from_world[j]),
+              0.0);
+  }
 }
 
 // The first five frames of the small orbit, every one a keyframe, without global BA: curves are

@@ -63,24 +63,6 @@ void printStatistics(const TrajectoryEvaluation& e) {
               e.rpe_rotation_stats.count);
 }
 
-nlohmann::json statisticsToJson(const ErrorStatistics& s) {
-  return {{"count", s.count}, {"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median},
-          {"std", s.std},     {"min", s.min},   {"max", s.max}};
-}
-
-nlohmann::json alignmentToJson(const TrajectoryEvaluation& e) {
-  const Sim3& a = e.ground_truth_from_estimate;
-  nlohmann::json rotation = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r)
-    rotation.push_back({a.rotation(r, 0), a.rotation(r, 1), a.rotation(r, 2)});
-  return {{"kind", toString(e.options.alignment)},
-          {"maps", "ground_truth_from_estimate: x_gt = scale * rotation * x_est + translation"},
-          {"scale", a.scale},
-          {"rotation", rotation},
-          {"rotation_angle_deg", rotationAngleDeg(a.rotation)},
-          {"translation_m", {a.translation.x(), a.translation.y(), a.translation.z()}}};
-}
-
 nlohmann::json perPoseToJson(const TrajectoryEvaluation& e) {
   nlohmann::json poses = {{"estimate_timestamp", nlohmann::json::array()},
                           {"ground_truth_timestamp", nlohmann::json::array()},

@@ -8,6 +8,7 @@
 #include "apps/cli/report_json.h"
 #include "apps/curve_ba_command.h"
 #include "apps/eval_command.h"
+#include "apps/eval_map_command.h"
 #include "apps/init_command.h"
 #include "apps/point_ba_command.h"
 #include "apps/report_command.h"
@@ -29,6 +30,7 @@ int main(int argc, char** argv) {
   curvesfm::PointBaCommand point_ba(&app);
   curvesfm::CurveBaCommand curve_ba(&app);
   curvesfm::EvalCommand eval(&app);
+  curvesfm::EvalMapCommand eval_map(&app);
   curvesfm::SynthCommand synth(&app);
   curvesfm::InitCommand init(&app);
   curvesfm::RunCommand run(&app);
@@ -41,6 +43,7 @@ int main(int argc, char** argv) {
     if (point_ba.selected()) point_ba.validate();
     if (curve_ba.selected()) curve_ba.validate();
     if (eval.selected()) eval.validate();
+    if (eval_map.selected()) eval_map.validate();
     if (synth.selected()) synth.validate();
     if (init.selected()) init.validate();
     if (run.selected()) run.validate();
@@ -56,6 +59,7 @@ int main(int argc, char** argv) {
     if (point_ba.selected()) return point_ba.run();
     if (curve_ba.selected()) return curve_ba.run();
     if (eval.selected()) return eval.run();
+    if (eval_map.selected()) return eval_map.run();
     if (synth.selected()) return synth.run();
     if (init.selected()) return init.run();
     if (run.selected()) return run.run();

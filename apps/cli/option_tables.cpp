@@ -1,6 +1,7 @@
 #include "apps/cli/option_tables.h"
 
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <locale>
 #include <sstream>
@@ -25,6 +26,35 @@ Eigen::Vector3d parseVector3(const std::string& text, const std::string& struct_
                          "expected three numbers \"x,y,z\"");
   }
   return v;
+}
+
+// "a,b,c" (one or more numbers) for a list flag; InvalidOptions naming `struct_name`.`field`.
+std::vector<double> parseNumberList(const std::string& text, const std::string& struct_name,
+                                    const std::string& field) {
+  std::vector<double> values;
+  std::istringstream in(text);
+  in.imbue(std::locale::classic());
+  for (;;) {
+    double value = 0.0;
+    if (!(in >> value) || !std::isfinite(value)) {
+      throw InvalidOptions(struct_name, field, "\"" + text + "\"",
+                           "expected comma-separated numbers \"a,b,...\"");
+    }
+    values.push_back(value);
+    char comma = 0;
+    if (!(in >> comma)) break;
+    if (comma != ',') {
+      throw InvalidOptions(struct_name, field, "\"" + text + "\"",
+                           "expected comma-separated numbers \"a,b,...\"");
+    }
+  }
+  return values;
+}
+
+std::string printNumberList(const std::vector<double>& values) {
+  std::string text;
+  for (const double value : values) text += (text.empty() ? "" : ",") + formatOptionValue(value);
+  return text;
 }
 
 std::string printVector3(const Eigen::Vector3d& v) {
@@ -573,6 +603,25 @@ void addTrajectoryEvaluationOptions(OptionsTable* table, TrajectoryEvaluationOpt
                    "Alignment of the estimate onto the ground truth (sim3 for monocular)")
       .number("max_dt", "max-dt", &o->max_dt, "Largest time difference of a matched pose pair (s)")
       .number("rpe_delta", "rpe-delta", &o->rpe_delta, "RPE over this many matched poses (frames)");
+}
+
+void addCurveMapEvaluationOptions(OptionsTable* table, CurveMapEvaluationOptions* o,
+                                  const OptionPlace& place) {
+  table->group(o, "CurveMapEvaluationOptions", place.path, place.prefix, place.heading)
+      .text(
+          "taus", "tau", "TAU[,TAU...]", [o] { return printNumberList(o->taus); },
+          [o](const std::string& text) {
+            o->taus = parseNumberList(text, "CurveMapEvaluationOptions", "taus");
+          },
+          "Distance thresholds, increasing (ground-truth units, e.g. m)")
+      .number("sample_spacing", "sample-spacing", &o->sample_spacing,
+              "Longest arc one sample of either map stands for (ground-truth units; 0: a tenth of "
+              "the smallest tau)")
+      .boolean("crop", "crop", &o->crop,
+               "Precision counts only the estimate inside the ground truth's bounding box grown "
+               "by --crop-margin")
+      .number("crop_margin", "crop-margin", &o->crop_margin,
+              "Growth of that box on every side (ground-truth units)");
 }
 
 }  // namespace curvesfm

@@ -4,6 +4,7 @@
 
 #include "apps/cli/options_table.h"
 #include "core/camera.h"
+#include "core/curve_map_evaluation.h"
 #include "core/image_sequence.h"
 #include "core/trajectory_evaluation.h"
 #include "factors/curve_bundle_adjustment.h"
@@ -81,5 +82,8 @@ void addPlanarSceneOptions(OptionsTable* table, PlanarSceneOptions* options,
 void addTwoViewOptions(OptionsTable* table, TwoViewOptions* options, const OptionPlace& place);
 void addTrajectoryEvaluationOptions(OptionsTable* table, TrajectoryEvaluationOptions* options,
                                     const OptionPlace& place);
+/// taus is one comma-separated flag value, e.g. `--tau 0.01,0.02,0.05`.
+void addCurveMapEvaluationOptions(OptionsTable* table, CurveMapEvaluationOptions* options,
+                                  const OptionPlace& place);
 
 }  // namespace curvesfm

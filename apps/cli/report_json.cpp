@@ -1,8 +1,10 @@
 #include "apps/cli/report_json.h"
 
+#include <Eigen/Geometry>
 #include <fstream>
 
 #include "apps/cli/version_info.h"  // generated under the build tree (apps/cli/CMakeLists.txt)
+#include "core/angles.h"
 #include "core/errors.h"
 
 namespace curvesfm {
@@ -89,6 +91,24 @@ nlohmann::json matchedPosesToJson(const TrajectoryEvaluation& evaluation) {
     poses["ground_truth_position"].push_back(xyz(m.ground_truth.translation()));
   }
   return poses;
+}
+
+nlohmann::json statisticsToJson(const ErrorStatistics& s) {
+  return {{"count", s.count}, {"rmse", s.rmse}, {"mean", s.mean}, {"median", s.median},
+          {"std", s.std},     {"min", s.min},   {"max", s.max}};
+}
+
+nlohmann::json alignmentToJson(const TrajectoryEvaluation& e) {
+  const Sim3& a = e.ground_truth_from_estimate;
+  nlohmann::json rotation = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r)
+    rotation.push_back({a.rotation(r, 0), a.rotation(r, 1), a.rotation(r, 2)});
+  return {{"kind", toString(e.options.alignment)},
+          {"maps", "ground_truth_from_estimate: x_gt = scale * rotation * x_est + translation"},
+          {"scale", a.scale},
+          {"rotation", rotation},
+          {"rotation_angle_deg", Eigen::AngleAxisd(a.rotation).angle() * kRadToDeg},
+          {"translation_m", {a.translation.x(), a.translation.y(), a.translation.z()}}};
 }
 
 void writeJsonFile(const std::string& path, const nlohmann::json& json) {

@@ -39,6 +39,13 @@ nlohmann::json sampleCountsToJson(const CurveSampleCounts& counts);
 /// figures draw the alignment without computing it again.
 nlohmann::json matchedPosesToJson(const TrajectoryEvaluation& evaluation);
 
+/// ErrorStatistics as {count, rmse, mean, median, std, min, max}.
+nlohmann::json statisticsToJson(const ErrorStatistics& statistics);
+
+/// The alignment of `evaluation` (ground_truth_from_estimate) as {kind, maps, scale, rotation
+/// (3x3 rows), rotation_angle_deg, translation_m}.
+nlohmann::json alignmentToJson(const TrajectoryEvaluation& evaluation);
+
 /// Writes `json` (indented) to `path`; IoError naming the path if it cannot.
 void writeJsonFile(const std::string& path, const nlohmann::json& json);
 

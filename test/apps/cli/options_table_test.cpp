@@ -33,12 +33,13 @@ struct AllOptions {
   OptimizerOptions optimizer;
   PlanarSceneOptions planar;
   TrajectoryEvaluationOptions evaluation;
+  CurveMapEvaluationOptions curve_map;
 };
 
-// The tables as the commands build them (run, curve-ba, point-ba, synth planar, eval); init's
-// table is run's point initialiser part.
+// The tables as the commands build them (run, curve-ba, point-ba, synth planar, eval, eval-map);
+// init's table is run's point initialiser part.
 std::vector<OptionsTable> commandTables(AllOptions* o) {
-  std::vector<OptionsTable> tables(5);
+  std::vector<OptionsTable> tables(6);
   addPipelineOptions(&tables[0], &o->pipeline, "/pipeline");
   addCurveOverlayOptions(&tables[0], &o->overlay, {"/overlay", "overlay-", "Overlays", ""});
   addPointInitialiserOptions(&tables[0], &o->points, "/points");
@@ -52,6 +53,10 @@ std::vector<OptionsTable> commandTables(AllOptions* o) {
   addOptimizerOptions(&tables[2], &o->optimizer, {"/optimizer", "", "Solver", ""});
   addPlanarSceneOptions(&tables[3], &o->planar, {"", "", "Scene", ""});
   addTrajectoryEvaluationOptions(&tables[4], &o->evaluation, {"", "", "Evaluation", ""});
+  addImageSequenceOptions(&tables[5], &o->sequence);
+  addTrajectoryEvaluationOptions(&tables[5], &o->evaluation,
+                                 {"/alignment", "", "Trajectory alignment", ""});
+  addCurveMapEvaluationOptions(&tables[5], &o->curve_map, {"/curve_map", "", "Curve map", ""});
   return tables;
 }
 

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "apps/cli/options_table.h"
+#include "core/curve_map_evaluation.h"
+#include "core/image_sequence.h"
+#include "core/trajectory_evaluation.h"
+
+namespace curvesfm {
+
+/// `curvesfm eval-map`: curve-map precision, recall and F-score at thresholds tau
+/// (core/curve_map_evaluation.h) of a run's curves against ground-truth curves (any format of
+/// readCurveMap: Pavilion's curve graph, synthcurves, an OBJ). The estimate is carried into the
+/// ground truth's frame by the Sim(3) (or SE(3)) that aligns its trajectory onto the ground-truth
+/// trajectory (compareTrajectories, as `eval` does), read from the dataset (loadImageSequence) or a
+/// TUM file; `--align none` takes the curves as they are. Prints a table per tau and writes every
+/// figure and option as JSON.
+class EvalMapCommand {
+ public:
+  explicit EvalMapCommand(CLI::App* app);
+  EvalMapCommand(const EvalMapCommand&) = delete;
+  EvalMapCommand& operator=(const EvalMapCommand&) = delete;
+  bool selected() const { return command_->parsed(); }
+  /// Throws InvalidOptions for values out of range and CLI::ValidationError for a missing input
+  /// (no curves, or no trajectory or ground truth to align with): usage errors, before any file
+  /// is read.
+  void validate() const;
+  /// Runs the command; returns the process exit code. Bad files throw IoError or ParseError
+  /// naming the file and line; trajectories that cannot be aligned TrajectoryEvaluationError.
+  int run() const;
+
+ private:
+  std::string curvesPath() const;
+  std::string trajectoryPath() const;
+
+  CLI::App* command_;
+  std::string run_dir_;
+  std::string curves_path_;
+  std::string trajectory_path_;
+  std::string dataset_dir_;
+  std::string ground_truth_trajectory_path_;
+  std::string ground_truth_curves_path_;
+  std::string json_path_;
+  ImageSequenceOptions sequence_;
+  TrajectoryEvaluationOptions alignment_;
+  CurveMapEvaluationOptions options_;
+  OptionsTable table_;  ///< Rows point into the options above: the command is not copied.
+};
+
+}  // namespace curvesfm

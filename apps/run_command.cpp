@@ -1,9 +1,11 @@
 #include "apps/run_command.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <optional>
 #include <string>
 #include <vector>
@@ -152,6 +154,74 @@ void printStageMotions(const std::vector<StageMotion>& motions) {
     if (!std::isnan(m.ate_rmse)) std::printf(" (ATE %.4g)", m.ate_rmse);
   }
   std::printf("\n");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Per-curve statistics (issue 14's diagnosis).
+
+void writeCurveStatisticsCsv(const std::string& path, const std::vector<CurveStatistics>& stats) {
+  std::ofstream out(path);
+  if (!out) throw IoError(path, "cannot open for writing");
+  out << "curve,first_keyframe,keyframes,observations,length,median_camera_distance,"
+         "triangulation_angle_deg,residual_rms_px,pose_pull,pose_pull_share\n";
+  for (std::size_t c = 0; c < stats.size(); ++c) {
+    const CurveStatistics& s = stats[c];
+    out << c << "," << s.first_keyframe << "," << s.keyframes << "," << s.observations << ","
+        << s.length << "," << s.median_camera_distance << "," << s.triangulation_angle_deg << ","
+        << s.residual_rms_px << "," << s.pose_pull << "," << s.pose_pull_share << "\n";
+  }
+  if (!out) throw IoError(path, "cannot write");
+}
+
+// The `count` curves ranked highest by `key`, as JSON (index into curves.obj / curves.csv).
+template <class Key>
+nlohmann::json worstCurves(const std::vector<CurveStatistics>& stats, std::size_t count, Key key) {
+  std::vector<std::size_t> order(stats.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return key(stats[a]) > key(stats[b]); });
+  nlohmann::json worst = nlohmann::json::array();
+  for (std::size_t i = 0; i < std::min(count, order.size()); ++i) {
+    const CurveStatistics& s = stats[order[i]];
+    worst.push_back({{"curve", order[i]},
+                     {"first_keyframe", s.first_keyframe},
+                     {"keyframes", s.keyframes},
+                     {"length", s.length},
+                     {"median_camera_distance", s.median_camera_distance},
+                     {"triangulation_angle_deg", s.triangulation_angle_deg},
+                     {"residual_rms_px", s.residual_rms_px},
+                     {"pose_pull_share", s.pose_pull_share}});
+  }
+  return worst;
+}
+
+nlohmann::json curveStatisticsJson(const std::vector<CurveStatistics>& stats) {
+  constexpr std::size_t kWorst = 10;
+  return {{"file", "curves.csv"},
+          {"most_pull",
+           worstCurves(stats, kWorst, [](const CurveStatistics& s) { return s.pose_pull_share; })},
+          {"highest_residual",
+           worstCurves(stats, kWorst, [](const CurveStatistics& s) { return s.residual_rms_px; })}};
+}
+
+// One line: the residual spread and how concentrated the pull on the poses is.
+void printCurveStatistics(const std::vector<CurveStatistics>& stats) {
+  if (stats.empty()) return;
+  std::vector<double> residuals;
+  std::vector<double> shares;
+  for (const CurveStatistics& s : stats) {
+    residuals.push_back(s.residual_rms_px);
+    shares.push_back(s.pose_pull_share);
+  }
+  std::sort(residuals.begin(), residuals.end());
+  std::sort(shares.rbegin(), shares.rend());
+  const std::size_t top = std::min<std::size_t>(10, shares.size());
+  const double top_share = std::accumulate(shares.begin(), shares.begin() + top, 0.0);
+  std::printf(
+      "curves: residual rms median %.2f px, 90th percentile %.2f px; the %zu curves pulling the "
+      "poses most hold %.0f %% of the pull (curves.csv, report.json curve_statistics)\n",
+      residuals[residuals.size() / 2], residuals[residuals.size() * 9 / 10], top,
+      100.0 * top_share);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -463,6 +533,7 @@ int RunCommand::run() const {
   }
   writeCurvesPly(joinPath(out_dir_, "curves.ply"), result.curves, export_samples_per_segment_);
   writeCurvesObj(joinPath(out_dir_, "curves.obj"), result.curves, export_samples_per_segment_);
+  writeCurveStatisticsCsv(joinPath(out_dir_, "curves.csv"), result.curve_statistics);
   writeConfigYaml(joinPath(out_dir_, "config.yaml"), *command_);
   const int overlays =
       overlays_ ? writeOverlays(joinPath(out_dir_, "overlays"), pipeline, result, overlay_) : 0;
@@ -504,13 +575,16 @@ int RunCommand::run() const {
        {"final_samples", sampleCountsToJson(result.final_samples)},
        {"ate", ateToJson(ate)},
        {"pose_stages", stageMotionsJson(motions, result.scene_scale)},
+       {"curve_statistics", curveStatisticsJson(result.curve_statistics)},
        {"total_seconds", seconds}});
 
   printSummary(input, result, seconds);
   printAte(ate, d.ground_truth_source);
   printStageMotions(motions);
+  printCurveStatistics(result.curve_statistics);
   std::printf(
-      "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, report.json, "
+      "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, curves.csv, "
+      "report.json, "
       "config.yaml%s%s)\n",
       out_dir_.c_str(), input.initialisation ? ", points.ply" : "", overlays_ ? ", overlays/" : "");
   std::fflush(stdout);  // The summary first, then why the run failed, if it did.

@@ -264,6 +264,7 @@ struct Pipeline::Impl {
   std::vector<int> depthReferences(int k, const std::vector<EdgeChain>& chains) const;
   EpipolarDepthOptions depthOptions(int k) const;
   PoseStage poseStage(const std::string& name) const;
+  std::vector<CurveStatistics> curveStatisticsInPoseUnits() const;
   void initialiseCurves(int k, const std::vector<EdgeChain>& chains, KeyframeStats* stats);
   std::vector<OpenEnd> openEnds(int k) const;
   void addInitialCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
@@ -454,6 +455,21 @@ PoseStage Pipeline::Impl::poseStage(const std::string& name) const {
                                                   : keyframe.given_cam_from_world);
   }
   return stage;
+}
+
+// The statistics of the curves finish() exports (the promoted ones, in the same order), with
+// lengths back in pose units and each curve's initialising keyframe.
+std::vector<CurveStatistics> Pipeline::Impl::curveStatisticsInPoseUnits() const {
+  if (keyframes.size() < 2) return {};
+  std::vector<int> ids;
+  std::vector<CurveStatistics> stats =
+      curveStatistics(bundleInput(CurveSelection::kPromoted, &ids), options.ba);
+  for (std::size_t c = 0; c < stats.size(); ++c) {
+    stats[c].length *= unit();
+    stats[c].median_camera_distance *= unit();
+    stats[c].first_keyframe = map.curve(ids[c]).first_keyframe;
+  }
+  return stats;
 }
 
 // The depth range of keyframe k's epipolar search: from the points it sees when there are
@@ -762,6 +778,7 @@ PipelineResult Pipeline::finish() {
   for (const PolyBezier& curve : impl.map.exportCurves(CurveSelection::kPromoted).curves) {
     result.curves.push_back(scaledCurve(curve, unit));
   }
+  result.curve_statistics = impl.curveStatisticsInPoseUnits();
   if (impl.options.ba.points) result.points = impl.points;
   result.frames = impl.frames;
   return result;

@@ -10,6 +10,7 @@
 #include "core/camera.h"
 #include "core/pose3.h"
 #include "factors/curve_bundle_adjustment.h"
+#include "factors/curve_statistics.h"
 #include "frontend/image/correspondence_checks.h"
 #include "frontend/image/curve_extension.h"
 #include "frontend/image/curve_initialiser.h"
@@ -235,6 +236,9 @@ struct PipelineResult {
   std::vector<Eigen::Vector3d> points;
   /// The keyframe poses after each stage, in order; the last is keyframe_cam_from_world.
   std::vector<PoseStage> pose_stages;
+  /// Per curve of `curves`, in order, at the final poses (factors/curve_statistics.h; lengths in
+  /// pose units; first_keyframe is the keyframe whose depth started the curve).
+  std::vector<CurveStatistics> curve_statistics;
 
   /// Wall time of the first global BA and of the re-association rounds' (s).
   double globalBaSeconds() const;

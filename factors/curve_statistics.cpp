@@ -1,0 +1,111 @@
+#include "factors/curve_statistics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "graph/key.h"
+
+namespace curvesfm {
+namespace {
+
+constexpr int kLengthSamplesPerSegment = 16;
+
+double arcLength(const PolyBezier& curve) {
+  double length = 0.0;
+  Eigen::Vector3d previous = curve.evaluate(0, 0.0);
+  for (int i = 0; i < curve.numSegments(); ++i) {
+    for (int k = 1; k <= kLengthSamplesPerSegment; ++k) {
+      const Eigen::Vector3d p =
+          curve.evaluate(i, static_cast<double>(k) / kLengthSamplesPerSegment);
+      length += (p - previous).norm();
+      previous = p;
+    }
+  }
+  return length;
+}
+
+Eigen::Vector3d middleOf(const PolyBezier& curve) {
+  const double t = 0.5 * curve.numSegments();
+  const int i = std::min(static_cast<int>(t), curve.numSegments() - 1);
+  return curve.evaluate(i, t - i);
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// Camera distances and the widest ray angle at `point` over the centres given.
+void viewingGeometry(const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& point,
+                     CurveStatistics* s) {
+  std::vector<double> distances;
+  for (const Eigen::Vector3d& c : centres) distances.push_back((c - point).norm());
+  s->median_camera_distance = median(distances);
+  double widest = 0.0;
+  for (std::size_t a = 0; a < centres.size(); ++a) {
+    for (std::size_t b = a + 1; b < centres.size(); ++b) {
+      const Eigen::Vector3d ra = centres[a] - point;
+      const Eigen::Vector3d rb = centres[b] - point;
+      widest = std::max(widest, std::atan2(ra.cross(rb).norm(), ra.dot(rb)));
+    }
+  }
+  s->triangulation_angle_deg = widest * 180.0 / M_PI;
+}
+
+}  // namespace
+
+std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& input,
+                                             const CurveBundleAdjustmentOptions& options) {
+  const std::size_t n = input.curves.size();
+  std::vector<CurveStatistics> stats(n);
+  std::vector<std::set<int>> keyframes_of(n);
+  for (const SegmentObservation& o : input.observations) {
+    ++stats[o.curve].observations;
+    keyframes_of[o.curve].insert(o.keyframe);
+  }
+  for (std::size_t c = 0; c < n; ++c) {
+    CurveStatistics& s = stats[c];
+    s.keyframes = static_cast<int>(keyframes_of[c].size());
+    s.first_keyframe = keyframes_of[c].empty() ? -1 : *keyframes_of[c].begin();
+    s.length = arcLength(input.curves[c]);
+    std::vector<Eigen::Vector3d> centres;
+    for (int j : keyframes_of[c]) centres.push_back(input.cam_from_world[j].inverseTranslation());
+    viewingGeometry(centres, middleOf(input.curves[c]), &s);
+  }
+  if (input.observations.empty()) return stats;
+
+  const CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options);
+  std::vector<double> squared(n, 0.0);
+  std::vector<int> rows(n, 0);
+  std::vector<std::map<int, Vector6d>> gradient(n);  // Per curve, per pose.
+  for (const auto& factor : problem.graph) {
+    const auto* edge = dynamic_cast<const CurveReprojectionFactor*>(factor.get());
+    if (edge == nullptr) continue;
+    const int pose = static_cast<int>(edge->keys()[0].index());
+    const std::size_t c = edge->keys()[1].index();
+    const Linearization l = edge->linearize(problem.values);
+    const NoiseModel& noise = edge->noiseModel();
+    double rho[3];
+    noise.kernel.evaluate(l.error.squaredNorm() / (noise.sigma * noise.sigma), rho);
+    const Vector6d g = rho[1] * l.jacobians[0].transpose() * l.error / (noise.sigma * noise.sigma);
+    auto [entry, inserted] = gradient[c].emplace(pose, g);
+    if (!inserted) entry->second += g;
+    squared[c] += l.error.squaredNorm();
+    rows[c] += static_cast<int>(l.error.size());
+  }
+  double total_pull = 0.0;
+  for (std::size_t c = 0; c < n; ++c) {
+    if (rows[c] > 0) stats[c].residual_rms_px = std::sqrt(squared[c] / rows[c]);
+    for (const auto& [pose, g] : gradient[c]) stats[c].pose_pull += g.norm();
+    total_pull += stats[c].pose_pull;
+  }
+  for (CurveStatistics& s : stats) {
+    s.pose_pull_share = total_pull > 0.0 ? s.pose_pull / total_pull : 0.0;
+  }
+  return stats;
+}
+
+}  // namespace curvesfm

@@ -1,0 +1,39 @@
+#pragma once
+
+#include <vector>
+
+#include "factors/curve_bundle_adjustment.h"
+
+namespace curvesfm {
+
+// What each curve of a curve bundle adjustment contributes (issue 14's diagnosis: which curves
+// pull the poses where). Read at the BA input's values, usually after the last global BA:
+//  - residual RMS over its samples in every keyframe that observes it (px; a capped sample, one
+//    beyond the field's reach or off the image, counts at the cap);
+//  - its track (observations and distinct keyframes), length, the median distance from the
+//    observing cameras to its middle and the widest angle between their rays there (a curve seen
+//    from nearly one direction has a poorly constrained depth);
+//  - its pull on the poses: the norm of its edge factors' part of the cost gradient with respect
+//    to each observing pose, J_pose^T rho'(s) r / sigma^2 with the robust kernel's weight,
+//    summed over those poses (whitened px per tangent unit: rotation and translation mixed, so
+//    a ranking, not a physical quantity), and that as a share of all curves' pull. At a converged
+//    BA the whole gradient is near zero, but each curve's part of it is what the other terms hold
+//    back: a few curves with most of the pull are the ones moving the trajectory.
+struct CurveStatistics {
+  int observations = 0;                  ///< (segment, keyframe) observations.
+  int keyframes = 0;                     ///< Distinct keyframes observing it (its track length).
+  int first_keyframe = -1;               ///< The first keyframe observing it.
+  double residual_rms_px = 0.0;          ///< RMS of its sample residuals (px).
+  double length = 0.0;                   ///< Arc length (the input's length unit).
+  double median_camera_distance = 0.0;   ///< Observing camera centres to its middle (length unit).
+  double triangulation_angle_deg = 0.0;  ///< Widest angle between observing rays at its middle.
+  double pose_pull = 0.0;                ///< See above.
+  double pose_pull_share = 0.0;  ///< pose_pull over the sum of all curves' (0 when none pull).
+};
+
+/// One entry per input curve, in input order. Builds the curve BA's graph
+/// (buildCurveBundleAdjustment) to evaluate its edge factors; the other terms are not counted.
+std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& input,
+                                             const CurveBundleAdjustmentOptions& options);
+
+}  // namespace curvesfm

@@ -1,0 +1,67 @@
+#include "factors/curve_statistics.h"
+
+#include <gtest/gtest.h>
+
+#include <numeric>
+
+#include "sim/curve_scene.h"
+#include "sim/curve_scene_input.h"
+
+namespace curvesfm {
+namespace {
+
+CurveScene smallScene() {
+  CurveSceneOptions options;
+  options.num_keyframes = 4;
+  return makeCurveScene(options);
+}
+
+TEST(CurveStatistics, DescribesEveryCurveAndSharesThePull) {
+  const CurveScene scene = smallScene();
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene, SceneStart::kTruth);
+  // One curve moved 5 cm across: it alone is off its edges, so it must have the largest residual
+  // and pull the poses hardest.
+  const int moved = 0;
+  std::vector<Eigen::Vector3d> points = input.curves[moved].points();
+  for (Eigen::Vector3d& p : points) p += Eigen::Vector3d(0.0, 0.05, 0.0);
+  input.curves[moved] =
+      PolyBezier(points, input.curves[moved].directions(), input.curves[moved].lengths());
+  const std::vector<CurveStatistics> stats = curveStatistics(input, {});
+  ASSERT_EQ(stats.size(), input.curves.size());
+  double shares = 0.0;
+  for (std::size_t c = 0; c < stats.size(); ++c) {
+    const CurveStatistics& s = stats[c];
+    shares += s.pose_pull_share;
+    EXPECT_GE(s.keyframes, 1);
+    EXPECT_GE(s.observations, s.keyframes);
+    EXPECT_GT(s.length, 0.0);
+    EXPECT_GT(s.median_camera_distance, 0.0);
+    if (static_cast<int>(c) == moved) continue;
+    EXPECT_LT(s.residual_rms_px, stats[moved].residual_rms_px) << "curve " << c;
+    EXPECT_LT(s.pose_pull, stats[moved].pose_pull) << "curve " << c;
+  }
+  EXPECT_NEAR(shares, 1.0, 1e-9);
+}
+
+TEST(CurveStatistics, GivesTheTrackOfEachCurveFromItsObservations) {
+  const CurveScene scene = smallScene();
+  const CurveBundleAdjustmentInput input =
+      makeCurveBundleAdjustmentInput(scene, SceneStart::kTruth);
+  const std::vector<CurveStatistics> stats = curveStatistics(input, {});
+  std::vector<int> observations(input.curves.size(), 0);
+  std::vector<int> first(input.curves.size(), 1 << 30);
+  for (const SegmentObservation& o : input.observations) {
+    ++observations[o.curve];
+    first[o.curve] = std::min(first[o.curve], o.keyframe);
+  }
+  for (std::size_t c = 0; c < stats.size(); ++c) {
+    EXPECT_EQ(stats[c].observations, observations[c]);
+    EXPECT_EQ(stats[c].first_keyframe, observations[c] > 0 ? first[c] : -1);
+    EXPECT_LE(stats[c].keyframes, 4);
+    EXPECT_GE(stats[c].triangulation_angle_deg, 0.0);
+    EXPECT_LT(stats[c].triangulation_angle_deg, 180.0);
+  }
+}
+
+}  // namespace
+}  // namespace curvesfm

@@ -17,7 +17,8 @@
 // --noise-rotation-deg, both per axis, Gaussian) and colmap (COLMAP's poses, which runs COLMAP
 // first). Each such row also holds the start's own ATE at the same keyframes (the run's
 // report.json) and refined / start; the summary prints them per set and start, with the spread
-// over the noise seeds, beside issue 14's targets.
+// over the noise seeds, beside issue 14's targets. A set with ground-truth curves (Pavilion) also
+// gets `curvesfm eval-map` on every curve run: precision and recall of the curve map at 2 cm.
 // curvesfm runs as a subprocess (--curvesfm, default the one built beside this bench); a variant
 // whose flags the executable does not list in its --help is skipped with a note, so the table
 // can name flags that a later curvesfm adds. Every trajectory (init: every registered frame;
@@ -69,6 +70,8 @@ struct RealSet {
   int max_frames = 0;  ///< Frame cap of this set (0: all); --max-frames lowers it further.
   int stride = 1;      ///< Every stride-th image.
   std::string why;     ///< Why the entry differs from the defaults, for the table's notes.
+  /// Ground-truth curves below --data (curvesfm eval-map's --gt-curves); empty: none.
+  std::string gt_curves = "";
 };
 
 // The sets of ../shared/data (INDEX.md there). 7-Scenes' camera-intrinsics.txt is the depth
@@ -79,7 +82,8 @@ const std::vector<RealSet> kSets = {
     {"kitti_odom06_first51", "kitti_odom06_first51/KITTI_sequence_1", "", 0, 1, ""},
     {"middlebury_templeRing_subset", "middlebury_templeRing_subset", "", 0, 1, ""},
     {"middlebury_templeSparseRing", "middlebury_templeSparseRing", "", 0, 1, ""},
-    {"pavilion_chair_midday", "pavilion_chair_midday/chair-sequence", "", 0, 1, ""},
+    {"pavilion_chair_midday", "pavilion_chair_midday/chair-sequence", "", 0, 1, "",
+     "pavilion_chair_midday/3d/cropped"},
     {"strecha_fountain-P11", "strecha_fountain-P11", "", 0, 1, ""},
 };
 
@@ -130,6 +134,9 @@ struct Row {
   ErrorStatistics rpe;        ///< RPE translation between consecutive evaluated poses.
   /// The start's ATE rmse at the evaluated keyframes (the run's report.json; NaN without).
   double start_ate = std::nan("");
+  /// Curve map against the set's ground-truth curves at 2 cm (curvesfm eval-map); NaN without.
+  double map_precision = std::nan("");
+  double map_recall = std::nan("");
   // Wall times (s); NaN where the variant has no such stage.
   double tracks_s = std::nan("");
   /// Tracks per frame scaled to 640x480 (ms; one core: curvesfm's tracking_threads 1).
@@ -282,6 +289,34 @@ std::vector<std::string> sequenceFlags(const RealSet& set, const ImageSequenceOp
   return flags;
 }
 
+/// Fills the curve-map columns from `curvesfm eval-map` on the run in `dir` against the set's
+/// ground-truth curves (precision and recall at 2 cm); a failure only adds a note.
+void evaluateCurveMap(const BenchOptions& options, const RealSet& set,
+                      const ImageSequenceOptions& sequence_options, const fs::path& dir, Row* row) {
+  std::vector<std::string> argv = {
+      options.curvesfm, "eval-map",
+      "--run",          dir.string(),
+      "--dataset",      (fs::path(options.data) / set.subdir).string(),
+      "--gt-curves",    (fs::path(options.data) / set.gt_curves).string(),
+      "--tau",          "0.01,0.02,0.05",
+      "--json",         (dir / "eval_map.json").string()};
+  const std::vector<std::string> own = sequenceFlags(set, sequence_options);
+  argv.insert(argv.end(), own.begin(), own.end());
+  const bench::ProcessResult r = bench::runProcess(argv, (dir / "eval_map.stdout.txt").string(),
+                                                   (dir / "eval_map.stderr.txt").string());
+  if (r.exit_code != 0) {
+    row->note += std::string(row->note.empty() ? "" : "; ") +
+                 "eval-map failed: " + bench::lastLine(r.stderr_log);
+    return;
+  }
+  for (const nlohmann::json& score :
+       readReport(dir / "eval_map.json").value("scores", nlohmann::json::array())) {
+    if (std::abs(number(score, "tau") - 0.02) > 1e-12) continue;
+    row->map_precision = number(score, "precision");
+    row->map_recall = number(score, "recall");
+  }
+}
+
 /// Runs a curvesfm variant; `init_poses` (a TUM file) is the start of a run, empty for the
 /// initialiser's.
 void runCurvesfm(const BenchOptions& options, const Variant& variant, const RealSet& set,
@@ -337,6 +372,9 @@ void runCurvesfm(const BenchOptions& options, const Variant& variant, const Real
     return;
   }
   evaluate(readTrajectory((dir / "trajectory.txt").string()), sequence, dir, row);
+  if (variant.command == "run" && !set.gt_curves.empty()) {
+    evaluateCurveMap(options, set, sequence_options, dir, row);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -572,7 +610,7 @@ void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
   std::ofstream out(path);
   if (!out) throw IoError(path.string(), "cannot open for writing");
   out << "set,variant,start,status,frames,registered,evaluated,start_ate_rmse,ate_rmse,ate_mean,"
-         "ate_median,"
+         "ate_median,map_precision_2cm,map_recall_2cm,"
          "rpe_translation_rmse,tracks_s,tracks_ms_per_640x480_frame,init_s,curves_s,local_ba_s,"
          "global_ba_s,extraction_s,"
          "matching_s,mapping_s,total_s,note\n";
@@ -584,6 +622,7 @@ void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
         << formatNumber(ok ? r.ate.rmse : nan, "%.9g") << ","
         << formatNumber(ok ? r.ate.mean : nan, "%.9g") << ","
         << formatNumber(ok ? r.ate.median : nan, "%.9g") << ","
+        << formatNumber(r.map_precision, "%.4g") << "," << formatNumber(r.map_recall, "%.4g") << ","
         << formatNumber(ok && r.rpe.count > 0 ? r.rpe.rmse : nan, "%.9g") << ","
         << formatNumber(r.tracks_s, "%.6g") << "," << formatNumber(r.tracks_ms, "%.6g") << ","
         << formatNumber(r.init_s, "%.6g") << "," << formatNumber(r.curves_s, "%.6g") << ","
@@ -610,8 +649,12 @@ std::string markdownRow(const Row& r) {
                                  : std::to_string(r.registered) + " / " + std::to_string(r.frames))
        << " | " << (ok ? std::to_string(r.evaluated) : "") << " | " << formatNumber(r.start_ate)
        << " | " << formatNumber(ok ? r.ate.rmse : nan) << " | "
-       << formatNumber(ok ? r.ate.rmse / r.start_ate : nan, "%.3f") << " | "
+       << formatNumber(ok && r.start != "truth" ? r.ate.rmse / r.start_ate : nan, "%.3f") << " | "
        << formatNumber(ok ? r.ate.mean : nan) << " | " << formatNumber(ok ? r.ate.median : nan)
+       << " | "
+       << (std::isnan(r.map_precision)
+               ? ""
+               : formatNumber(r.map_precision, "%.3f") + " / " + formatNumber(r.map_recall, "%.3f"))
        << " | " << formatNumber(ok && r.rpe.count > 0 ? r.rpe.rmse : nan) << " | "
        << formatNumber(r.tracks_s, "%.1f") << " | " << formatNumber(r.tracks_ms, "%.1f") << " | "
        << formatNumber(r.init_s, "%.1f") << " | " << formatNumber(r.curves_s, "%.1f") << " | "
@@ -624,11 +667,11 @@ std::string markdownRow(const Row& r) {
 std::string markdownTable(const std::vector<Row>& rows) {
   std::ostringstream out;
   out << "| set | variant | start | registered | evaluated | start ATE | ATE rmse | ATE / start "
-         "| ATE mean | ATE median | RPE t rmse "
+         "| ATE mean | ATE median | map P / R at 2 cm | RPE t rmse "
          "| tracks s | tracks ms per 640x480 frame, one core | init s | curves s | local BA s | "
          "global BA s | COLMAP extract / match / "
          "map s | total s | note |\n"
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) out << markdownRow(r) << "\n";
   return out.str();
 }

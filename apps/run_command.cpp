@@ -406,6 +406,93 @@ nlohmann::json reassociationToJson(const std::vector<ReassociationRound>& rounds
   return json;
 }
 
+nlohmann::json vectorToJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+int countImplausible(const RunSanity& s, CurveImplausibility reason) {
+  return static_cast<int>(
+      std::count_if(s.implausible_curves.begin(), s.implausible_curves.end(),
+                    [reason](const ImplausibleCurve& c) { return c.reason == reason; }));
+}
+
+nlohmann::json sanityToJson(const RunSanity& s) {
+  nlohmann::json extent = nullptr;
+  if (s.extent.valid()) {
+    extent = {{"min", vectorToJson(s.extent.min)},
+              {"max", vectorToJson(s.extent.max)},
+              {"diagonal", s.extent.diagonal()},
+              {"from", s.extent.source.empty() ? "cameras" : "cameras and " + s.extent.source}};
+  }
+  nlohmann::json curves = nlohmann::json::array();
+  for (const ImplausibleCurve& c : s.implausible_curves) {
+    curves.push_back({{"id", c.id},
+                      {"segments", c.segments},
+                      {"length", c.length},
+                      {"reason", toString(c.reason)},
+                      {"after_global_bas", c.after_global_bas},
+                      {"dropped", c.dropped}});
+  }
+  nlohmann::json move = nullptr;
+  if (s.pose_move.keyframe >= 0) {
+    move = {{"keyframe", s.pose_move.keyframe},
+            {"distance", s.pose_move.distance},
+            {"spacing", s.pose_move.spacing},
+            {"spacings", s.pose_move.spacings()}};
+  }
+  nlohmann::json verdicts = nlohmann::json::array();
+  for (const RunVerdict& v : s.verdicts) {
+    verdicts.push_back({{"kind", toString(v.kind)}, {"message", v.message}});
+  }
+  return {{"extent", extent},
+          {"counts",
+           {{"checked", s.checked_curves},
+            {"implausible", s.implausible_curves.size()},
+            {"dropped", s.droppedCurves()},
+            {"outside_extent", countImplausible(s, CurveImplausibility::kOutsideExtent)},
+            {"longer_than_extent", countImplausible(s, CurveImplausibility::kLongerThanExtent)}}},
+          {"implausible_curves", curves},
+          {"largest_pose_move", move},
+          {"verdicts", verdicts}};
+}
+
+// The sanity lines of the summary: the extent, the implausible curves (the first few listed) and
+// the largest pose move, then one "warning:" line per verdict.
+void printSanity(const RunSanity& s) {
+  constexpr std::size_t kListed = 10;
+  if (s.extent.valid()) {
+    const Eigen::Vector3d size = s.extent.max - s.extent.min;
+    std::printf("sanity: scene extent %.4g x %.4g x %.4g (diagonal %.4g, from the cameras%s%s)",
+                size.x(), size.y(), size.z(), s.extent.diagonal(),
+                s.extent.source.empty() ? "" : " and the ", s.extent.source.c_str());
+  } else {
+    std::printf("sanity: no scene extent (too few cameras and points)");
+  }
+  std::printf(
+      "; %zu of %d curves of the global map implausible (%d outside the extent, %d longer than "
+      "it), %d dropped",
+      s.implausible_curves.size(), s.checked_curves,
+      countImplausible(s, CurveImplausibility::kOutsideExtent),
+      countImplausible(s, CurveImplausibility::kLongerThanExtent), s.droppedCurves());
+  if (s.pose_move.keyframe >= 0) {
+    std::printf("; largest pose move %.3g keyframe spacings (keyframe %d)", s.pose_move.spacings(),
+                s.pose_move.keyframe);
+  }
+  std::printf("\n");
+  for (std::size_t i = 0; i < s.implausible_curves.size() && i < kListed; ++i) {
+    const ImplausibleCurve& c = s.implausible_curves[i];
+    std::printf("  curve %d: %d segments, length %.4g, %s, %s after %d global BA%s\n", c.id,
+                c.segments, c.length,
+                c.reason == CurveImplausibility::kOutsideExtent ? "outside the extent"
+                                                                : "longer than the extent",
+                c.dropped ? "dropped" : "kept", c.after_global_bas,
+                c.after_global_bas == 1 ? "" : "s");
+  }
+  if (s.implausible_curves.size() > kListed) {
+    std::printf("  ... and %zu more (report.json, sanity.implausible_curves)\n",
+                s.implausible_curves.size() - kListed);
+  }
+  for (const RunVerdict& v : s.verdicts) std::printf("warning: %s\n", v.message.c_str());
+}
+
 bool globalBaUsable(const ScheduleReport& report) {
   for (const ScheduleRound& round : report.rounds) {
     if (!round.skipped && !round.summary.usable) return false;
@@ -576,18 +663,27 @@ int RunCommand::run() const {
        {"ate", ateToJson(ate)},
        {"pose_stages", stageMotionsJson(motions, result.scene_scale)},
        {"curve_statistics", curveStatisticsJson(result.curve_statistics)},
+       {"sanity", sanityToJson(result.sanity)},
        {"total_seconds", seconds}});
 
   printSummary(input, result, seconds);
   printAte(ate, d.ground_truth_source);
   printStageMotions(motions);
   printCurveStatistics(result.curve_statistics);
+  printSanity(result.sanity);
   std::printf(
       "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, curves.csv, "
       "report.json, "
       "config.yaml%s%s)\n",
       out_dir_.c_str(), input.initialisation ? ", points.ply" : "", overlays_ ? ", overlays/" : "");
   std::fflush(stdout);  // The summary first, then why the run failed, if it did.
+  if (result.curves.empty() && result.sanity.droppedCurves() > 0) {
+    std::fprintf(stderr,
+                 "run: every curve of the global map (%d) was implausible and dropped: nothing "
+                 "plausible was reconstructed (see the sanity lines and report.json)\n",
+                 result.sanity.droppedCurves());
+    return 1;
+  }
   if (result.curves.empty()) {
     std::fprintf(stderr,
                  "run: no curve reached the global map: nothing was reconstructed (see "

@@ -319,6 +319,29 @@ void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentO
               "Std dev of that distance constraint (scene units)");
 }
 
+void addSanityOptions(OptionsTable* table, SanityOptions* o, const OptionPlace& place) {
+  table->group(o, "SanityOptions", place.path, place.prefix, place.heading)
+      .boolean("drop_implausible_curves", "drop-curves", &o->drop_implausible_curves,
+               "Drop curves outside the scene's extent or longer than its diagonal (else only "
+               "list them)")
+      .number("extent_percentile", "extent-percentile", &o->extent_percentile,
+              "The extent spans the points between this percentile and 100 minus it per axis, "
+              "and every camera (%)")
+      .number("extent_margin", "extent-margin", &o->extent_margin,
+              "Enlarge the extent on every side by this fraction of its diagonal")
+      .number("samples_per_segment", "samples-per-segment", &o->samples_per_segment,
+              "Samples per segment checked against the extent")
+      .number("max_implausible_fraction", "max-implausible-fraction", &o->max_implausible_fraction,
+              "Verdict when more than this fraction of the global map's curves is implausible")
+      .number("max_pose_move_spacings", "max-pose-move", &o->max_pose_move_spacings,
+              "Verdict when a refined keyframe moved more than this many keyframe spacings "
+              "(after Sim(3) alignment onto the initial poses)")
+      .number("min_keyframes", "min-keyframes", &o->min_keyframes,
+              "Verdict when the run has fewer keyframes")
+      .number("min_curves", "min-curves", &o->min_curves,
+              "Verdict when the final map has fewer curves");
+}
+
 void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::string& path) {
   table->group(o, "PipelineOptions", path, "", "Pipeline")
       .number("scene_scale", "scene-scale", &o->scene_scale,
@@ -353,7 +376,8 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
       .boolean("point_depth_range", "point-depth-range", &o->point_depth_range,
                "Take each keyframe's depth range from the initialiser's points it sees")
       .number("point_depth_margin", "point-depth-margin", &o->point_depth_margin,
-              "Widen the points' depth range by this factor on both sides");
+              "Widen the points' depth range by this factor on both sides")
+      .nested("sanity");
   addImageStages(table, o, path);
   addDepth(table, &o->depth, path);
   addCurveStages(table, o, path);
@@ -366,6 +390,7 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
                       &o->ba.fix_first_pose);
   addOptimizerOptions(table, &o->tracking,
                       {path + "/tracking", "track-", "Pose tracking", "pose tracking"});
+  addSanityOptions(table, &o->sanity, stage(path, "sanity", "sanity-", "Sanity checks"));
 }
 
 void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* o, const OptionPlace& place) {

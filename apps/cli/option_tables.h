@@ -52,6 +52,8 @@ void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentO
 /// Every stage of the pipeline under `path`, flags named by stage (`--edges-*`, `--depth-*`,
 /// `--local-ba-*`, ...).
 void addPipelineOptions(OptionsTable* table, PipelineOptions* options, const std::string& path);
+/// The sanity checks of the pipeline (`--sanity-*` in run).
+void addSanityOptions(OptionsTable* table, SanityOptions* options, const OptionPlace& place);
 void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* options,
                             const OptionPlace& place);
 /// The point-based initialiser (init, and run without initial poses): every flag starts with

@@ -120,6 +120,11 @@ void CurveMap::extendCurve(int id, const PolyBezier& extended, CurveEnd end) {
   }
 }
 
+void CurveMap::dropImplausible(int id) {
+  curve(id);
+  curves_[id].state = CurveState::kImplausible;
+}
+
 bool CurveMap::mostlyUnseen(const MapCurve& curve, int keyframe) const {
   const int first =
       std::max(curve.first_keyframe, keyframe - options_.disable_window_keyframes + 1);
@@ -130,6 +135,7 @@ bool CurveMap::mostlyUnseen(const MapCurve& curve, int keyframe) const {
 
 void CurveMap::endKeyframe(int keyframe) {
   for (MapCurve& c : curves_) {
+    if (c.state == CurveState::kImplausible) continue;
     if (c.state == CurveState::kDisabled) {
       if (c.observedIn(keyframe))
         c.state = c.promoted ? CurveState::kGlobal : CurveState::kTemporary;
@@ -148,8 +154,9 @@ ExportedCurves CurveMap::exportCurves(CurveSelection selection) const {
   ExportedCurves exported;
   for (int id = 0; id < size(); ++id) {
     const MapCurve& c = curves_[id];
-    const bool selected =
-        selection == CurveSelection::kGlobal ? c.state == CurveState::kGlobal : c.promoted;
+    const bool selected = selection == CurveSelection::kGlobal
+                              ? c.state == CurveState::kGlobal
+                              : c.promoted && c.state != CurveState::kImplausible;
     if (!selected) continue;
     const int index = static_cast<int>(exported.ids.size());
     exported.ids.push_back(id);

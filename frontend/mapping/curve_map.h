@@ -46,14 +46,18 @@ enum class CurveState {
   kTemporary,  ///< Newly initialised; registered in new keyframes but constrains no pose.
   kGlobal,     ///< Well observed; takes part in bundle adjustment.
   kDisabled,   ///< Mostly unseen lately; out of bundle adjustment until seen again.
+  /// Dropped by the sanity checks (SanityOptions): out of bundle adjustment, re-association and
+  /// the result for good.
+  kImplausible,
 };
 
 template <>
 struct EnumNames<CurveState> {
-  static constexpr std::array<std::pair<CurveState, const char*>, 3> kNames = {{
+  static constexpr std::array<std::pair<CurveState, const char*>, 4> kNames = {{
       {CurveState::kTemporary, "temporary"},
       {CurveState::kGlobal, "global"},
       {CurveState::kDisabled, "disabled"},
+      {CurveState::kImplausible, "implausible"},
   }};
 };
 
@@ -98,8 +102,8 @@ struct ExportedCurves {
 /// Which curves an export takes.
 enum class CurveSelection {
   kGlobal,    ///< Curves in the global map now (local BA).
-  kPromoted,  ///< Every curve that ever reached the global map, disabled ones too (global BA,
-              ///< the final result).
+  kPromoted,  ///< Every curve that ever reached the global map, disabled ones too, implausible
+              ///< ones not (global BA, the final result).
 };
 
 /// The temporary and global maps as one container of curves with a state each (paper §3.3):
@@ -140,6 +144,11 @@ class CurveMap {
   /// keyframe after being disabled is not disabled again before the next keyframe. A curve
   /// younger than the window is judged on the keyframes it has existed for.
   void endKeyframe(int keyframe);
+
+  /// Drops curve `id` from the map for good (CurveState::kImplausible): no export, no
+  /// registration, no state change at endKeyframe. Its id stays valid. Throws CheckError on a bad
+  /// id.
+  void dropImplausible(int id);
 
   /// The selected curves (renumbered 0..n-1 in increasing id) and their observations.
   ExportedCurves exportCurves(CurveSelection selection) const;

@@ -227,6 +227,7 @@ void PipelineOptions::validate() const {
   local_ba.validate();
   global_ba.validate();
   tracking.validate();
+  sanity.validate();
   const OptionCheck require("PipelineOptions");
   require(point_depth_margin >= 1.0 && point_depth_margin < 1e6, "point_depth_margin",
           point_depth_margin, "finite and >= 1");
@@ -277,6 +278,8 @@ struct Pipeline::Impl {
   std::vector<int> addPointsTo(CurveBundleAdjustmentInput* input) const;
   ScheduleReport bundleAdjust(CurveSelection selection, const SchedulerOptions& scheduler,
                               bool refine_poses, CurveSampleCounts* samples);
+  SceneExtent currentExtent() const;
+  void checkCurves(bool drop);
 
   PipelineOptions options;
   ImageUndistorter undistorter;
@@ -290,6 +293,11 @@ struct Pipeline::Impl {
   double scene_scale = 0.0;             // Pose units; 0 until known.
   std::vector<Eigen::Vector3d> points;  // The hybrid graph's, world frame, pose units.
   Eigen::Vector3d first_centre = Eigen::Vector3d::Zero();  // Initial centre of frame 0.
+  // The sanity checks (checkCurves): what they found, the last extent (scene scale) and the
+  // global BAs run so far.
+  std::vector<ImplausibleCurve> implausible;
+  SceneExtent extent;
+  int global_bas = 0;
 };
 
 // Derives the scene scale from the first frame that moved away from frame 0 (see
@@ -670,6 +678,42 @@ ScheduleReport Pipeline::Impl::bundleAdjust(CurveSelection selection,
   return report;
 }
 
+// The scene's extent now, in the scene scale: the keyframe centres and the points, or without
+// points the end points of the curves that reached the global map. Runaway curves are few among
+// many, so the percentiles leave them out of an extent they define.
+SceneExtent Pipeline::Impl::currentExtent() const {
+  constexpr std::size_t kMinPoints = 10;
+  std::vector<Eigen::Vector3d> centres;
+  for (const Keyframe& keyframe : keyframes) {
+    centres.push_back(keyframe.cam_from_world.inverseTranslation());
+  }
+  std::vector<Eigen::Vector3d> scene;
+  if (points.size() >= kMinPoints) {
+    for (const Eigen::Vector3d& p : points) scene.push_back(p / unit());
+    return sceneExtent(centres, scene, "points", options.sanity);
+  }
+  for (const PolyBezier& curve : map.exportCurves(CurveSelection::kPromoted).curves) {
+    scene.insert(scene.end(), curve.points().begin(), curve.points().end());
+  }
+  return sceneExtent(centres, scene, "curves", options.sanity);
+}
+
+// Judges every curve that reached the global map against the current extent and, with `drop`,
+// drops the implausible ones from the map.
+void Pipeline::Impl::checkCurves(bool drop) {
+  extent = currentExtent();
+  if (!extent.valid()) return;
+  const ExportedCurves promoted = map.exportCurves(CurveSelection::kPromoted);
+  for (std::size_t i = 0; i < promoted.ids.size(); ++i) {
+    const CurveCheck check =
+        checkCurve(promoted.curves[i], extent, options.sanity.samples_per_segment);
+    if (check.reason == CurveImplausibility::kNone) continue;
+    implausible.push_back({promoted.ids[i], promoted.curves[i].numSegments(), check.length * unit(),
+                           check.reason, global_bas, drop});
+    if (drop) map.dropImplausible(promoted.ids[i]);
+  }
+}
+
 KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   CURVESFM_CHECK(!finished) << "Pipeline::addFrame after finish()";
   KeyframeStats stats;
@@ -753,20 +797,30 @@ PipelineResult Pipeline::finish() {
   impl.finished = true;
   PipelineResult result;
   result.pose_stages.push_back(impl.poseStage("incremental"));
+  const bool drop = impl.options.sanity.drop_implausible_curves;
+  // Every curve that reached the global map: the curves the sanity checks judge.
+  const int promoted =
+      static_cast<int>(impl.map.exportCurves(CurveSelection::kPromoted).ids.size());
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
+    if (drop) impl.checkCurves(true);
     result.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
                                          /*refine_poses=*/true, &result.final_samples);
     result.pose_stages.push_back(impl.poseStage("global_ba"));
+    ++impl.global_bas;
     for (int r = 0; r < impl.options.reassociation_rounds; ++r) {
+      // Before re-association, so that no runaway curve gains observations.
+      if (drop) impl.checkCurves(true);
       ReassociationRound round;
       round.added_observations = impl.reassociate();
       if (round.added_observations == 0) break;
       round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
                                           /*refine_poses=*/true, &result.final_samples);
+      ++impl.global_bas;
       result.reassociation.push_back(std::move(round));
       result.pose_stages.push_back(impl.poseStage("reassociation_" + std::to_string(r + 1)));
     }
   }
+  impl.checkCurves(drop);
   // Back from the scene scale to the unit of the poses given.
   const double unit = impl.unit();
   result.scene_scale = impl.scene_scale;
@@ -781,6 +835,16 @@ PipelineResult Pipeline::finish() {
   result.curve_statistics = impl.curveStatisticsInPoseUnits();
   if (impl.options.ba.points) result.points = impl.points;
   result.frames = impl.frames;
+
+  RunSanity& sanity = result.sanity;
+  sanity.extent = impl.extent.scaled(unit);
+  sanity.checked_curves = promoted;
+  sanity.implausible_curves = impl.implausible;
+  sanity.pose_move =
+      largestPoseMove(result.keyframe_initial_cam_from_world, result.keyframe_cam_from_world);
+  sanity.verdicts = judgeRun(
+      static_cast<int>(impl.keyframes.size()), static_cast<int>(result.curves.size()), promoted,
+      static_cast<int>(impl.implausible.size()), sanity.pose_move, impl.options.sanity);
   return result;
 }
 

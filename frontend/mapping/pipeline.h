@@ -19,6 +19,7 @@
 #include "frontend/image/epipolar_depth.h"
 #include "frontend/image/image_undistorter.h"
 #include "frontend/mapping/curve_map.h"
+#include "frontend/mapping/sanity_checks.h"
 #include "graph/scheduler.h"
 
 namespace curvesfm {
@@ -123,6 +124,9 @@ struct PipelineOptions {
   /// keyframe count as explained by it; only runs of unexplained pixels (at least
   /// chains.min_length_px long) seed new curves (px). Finite, >= 0.
   double explained_radius_px = 3.0;
+  /// Which curves are implausible (dropped before every global BA and from the result) and when
+  /// the run gets a verdict (PipelineResult::sanity).
+  SanityOptions sanity;
 
   /// Throws InvalidOptions naming the stage struct, the field, its value and the constraint.
   void validate() const;
@@ -239,6 +243,9 @@ struct PipelineResult {
   /// Per curve of `curves`, in order, at the final poses (factors/curve_statistics.h; lengths in
   /// pose units; first_keyframe is the keyframe whose depth started the curve).
   std::vector<CurveStatistics> curve_statistics;
+  /// The scene's extent, the implausible curves (those dropped are not in `curves`), the largest
+  /// pose move and the verdicts; lengths in pose units.
+  RunSanity sanity;
 
   /// Wall time of the first global BA and of the re-association rounds' (s).
   double globalBaSeconds() const;
@@ -261,7 +268,12 @@ struct PipelineResult {
 /// (CurveExtensionOptions); the others start new curves. The length regulariser E_s1 of every BA is
 /// relative to the curve's length when that BA starts, not at its initialisation
 /// (buildCurveBundleAdjustment takes the input curves as the reference). finish() runs global BA
-/// over every curve that reached the global map, then the re-association rounds.
+/// over every curve that reached the global map, then the re-association rounds. Before every
+/// global BA and after the last one, the curves that reached the global map are checked against
+/// the scene's extent (sceneExtent: the keyframe centres and the points of setPoints(), or
+/// without points the curves' own points, robustly); implausible ones are dropped for good
+/// (SanityOptions). One that only the last global BA made implausible leaves the result but was
+/// in that BA. finish() then judges the run (judgeRun).
 class Pipeline {
  public:
   /// Throws InvalidOptions (options) or CheckError (camera).

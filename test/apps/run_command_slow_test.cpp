@@ -80,6 +80,18 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   }
   EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));
   EXPECT_TRUE(report["ate"]["refined_m"].contains("rmse"));
+  // The sanity checks: the extent, the counts, and each verdict printed as a warning line.
+  EXPECT_THAT(result.output, HasSubstr("sanity: scene extent "));
+  const nlohmann::json& sanity = report["sanity"];
+  EXPECT_GT(sanity["extent"]["diagonal"].get<double>(), 0.0);
+  EXPECT_EQ(sanity["counts"]["checked"].get<int>(),
+            report["counts"]["curves"].get<int>() + sanity["counts"]["dropped"].get<int>());
+  EXPECT_EQ(sanity["implausible_curves"].size(), sanity["counts"]["implausible"].get<size_t>());
+  EXPECT_TRUE(sanity["largest_pose_move"].contains("spacings"));
+  ASSERT_TRUE(sanity["verdicts"].is_array());
+  for (const auto& verdict : sanity["verdicts"]) {
+    EXPECT_THAT(result.output, HasSubstr("warning: " + verdict["message"].get<std::string>()));
+  }
   // What `curvesfm report` draws: the initial keyframe poses, the undistorted camera, and the
   // aligned positions of both trajectories beside the ground truth's.
   EXPECT_EQ(readTrajectory(out + "/trajectory_initial.txt").size(), 6u);

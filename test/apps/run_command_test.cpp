@@ -120,6 +120,10 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   result = run("--track-max-iterations -1");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--track-max-iterations = -1"));
+  result = run("--sanity-extent-margin -1");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--sanity-extent-margin = -1: must be >= 0 and finite "
+                                       "(SanityOptions.extent_margin)"));
   result = run("--local-ba-strategy sideways");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--local-ba-strategy"));

@@ -182,6 +182,26 @@ TEST(CurveMap, ExtendingAtTheFrontMovesObservationsWithTheirSegments) {
   EXPECT_EQ(c.segments[4].observations[0].observation.segment, 4);
 }
 
+// A dropped curve leaves every export and stays dropped, whatever the keyframes see.
+TEST(CurveMap, DroppedCurveLeavesEveryExportForGood) {
+  CurveMap map;
+  const int kept = map.addCurve(straightCurve(2), 0);
+  const int dropped = map.addCurve(straightCurve(2), 0);
+  for (int k = 0; k < 3; ++k) {
+    for (const int id : {kept, dropped}) observeSegments(&map, id, 0, 1, k);
+    map.endKeyframe(k);
+  }
+  map.dropImplausible(dropped);
+  observeSegments(&map, dropped, 0, 1, 3);
+  map.endKeyframe(3);
+  EXPECT_EQ(map.curve(dropped).state, CurveState::kImplausible);
+  EXPECT_EQ(map.count(CurveState::kGlobal), 1);
+  for (const CurveSelection selection : {CurveSelection::kGlobal, CurveSelection::kPromoted}) {
+    EXPECT_EQ(map.exportCurves(selection).ids, std::vector<int>{kept});
+  }
+  EXPECT_THROW(map.dropImplausible(7), CheckError);
+}
+
 TEST(CurveMapOptions, ValidateNamesTheField) {
   CurveMapOptions options;
   options.disable_unseen_fraction = 1.0;

@@ -103,6 +103,14 @@ TEST(Pipeline, RefinesAPerturbedPlanarTrajectory) {
                                    result.keyframe_cam_from_world[j]),
               0.0);
   }
+  // A normal run is plausible: no curve leaves the scene, no verdict.
+  EXPECT_TRUE(result.sanity.extent.valid());
+  EXPECT_EQ(result.sanity.checked_curves, static_cast<int>(result.curves.size()));
+  EXPECT_TRUE(result.sanity.implausible_curves.empty())
+      << "curve " << result.sanity.implausible_curves[0].id << ", length "
+      << result.sanity.implausible_curves[0].length;
+  for (const RunVerdict& verdict : result.sanity.verdicts) ADD_FAILURE() << verdict.message;
+  EXPECT_GE(result.sanity.pose_move.keyframe, 0);
 }
 
 // The first five frames of the small orbit, every one a keyframe, without global BA: curves are
@@ -158,6 +166,59 @@ TEST(Pipeline, ExtendsCurvesThatNewEdgesContinue) {
   EXPECT_GT(extended_with, 0);
   EXPECT_EQ(extended_without, 0);
   EXPECT_LT(started_with, started_without);
+}
+
+// Points on a 4 cm patch at the plane's centre, no margin: the extent is the box of the cameras
+// and that patch, so the curves on the plane beyond it leave the extent. They are dropped,
+// listed, and out of the result; and a pose-move threshold below what global BA moves the poses
+// gives that verdict (largestPoseMove's own test makes a pose jump far).
+TEST(Pipeline, DropsCurvesOutsideTheExtentAndJudgesTheRun) {
+  PlanarSceneOptions orbit = smallOrbit();
+  orbit.num_frames = 5;
+  const PlanarScene scene = makePlanarScene(planarTexture(), orbit);
+  PipelineOptions options;
+  options.reassociation_rounds = 1;
+  options.sanity.extent_margin = 0.0;
+  options.sanity.extent_percentile = 0.0;
+  options.sanity.max_pose_move_spacings = 1e-6;
+  options.sanity.min_curves = 0;
+  Pipeline pipeline(*scene.camera, options);
+  std::vector<Eigen::Vector3d> patch;
+  for (int i = 0; i < 5; ++i) {
+    for (int j = 0; j < 5; ++j) patch.emplace_back(-0.02 + 0.01 * i, -0.02 + 0.01 * j, 0.0);
+  }
+  pipeline.setPoints(patch);
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
+  }
+  const PipelineResult result = pipeline.finish();
+  const RunSanity& sanity = result.sanity;
+  ASSERT_TRUE(sanity.extent.valid());
+  EXPECT_EQ(sanity.extent.source, "points");
+  ASSERT_FALSE(sanity.implausible_curves.empty());
+  EXPECT_EQ(sanity.droppedCurves(), static_cast<int>(sanity.implausible_curves.size()));
+  EXPECT_EQ(sanity.checked_curves,
+            static_cast<int>(result.curves.size() + sanity.implausible_curves.size()));
+  for (const ImplausibleCurve& c : sanity.implausible_curves) {
+    EXPECT_NE(c.reason, CurveImplausibility::kNone) << "curve " << c.id;
+    EXPECT_GT(c.length, 0.0);
+  }
+  // The curves were checked again after the last global BA: what is exported lies inside.
+  ASSERT_FALSE(result.curves.empty());
+  for (const PolyBezier& curve : result.curves) {
+    EXPECT_EQ(checkCurve(curve, sanity.extent, options.sanity.samples_per_segment).reason,
+              CurveImplausibility::kNone);
+  }
+  // Most of the plane lies beyond the patch: most curves go, and that is a verdict too.
+  std::vector<RunVerdictKind> expected;
+  if (2 * sanity.implausible_curves.size() > static_cast<std::size_t>(sanity.checked_curves)) {
+    expected.push_back(RunVerdictKind::kMostCurvesImplausible);
+  }
+  expected.push_back(RunVerdictKind::kPosesMovedFar);
+  std::vector<RunVerdictKind> kinds;
+  for (const RunVerdict& verdict : sanity.verdicts) kinds.push_back(verdict.kind);
+  EXPECT_EQ(kinds, expected);
+  EXPECT_GT(sanity.pose_move.spacings(), 1e-6);
 }
 
 // The five frames of the small orbit with global BA and one re-association round, every length

@@ -103,6 +103,21 @@ TEST(FeatureMatching, OrbMatchesAgreeWithThePlanesHomography) {
   }
 }
 
+TEST(FeatureMatching, KeypointsDetectedOnASmallerImageComeBackInFullSizePixels) {
+  FeatureMatchingOptions options;
+  options.detection_scale = 0.5;
+  const std::vector<FeatureMatch> matches = matchViews(options);
+  const int within = agreeing(matches);
+  std::cout << "SIFT at half size: " << matches.size() << " matches, " << within
+            << " within 2 px\n";
+  // A pixel mapped back without the half-pixel shift of the centres' convention would still
+  // agree; one left at half scale would not (the views' homography is far from a scaling).
+  EXPECT_GT(matches.size(), 30u);
+  EXPECT_GT(within, 0.85 * matches.size());
+  options.detection_scale = 0.0;
+  EXPECT_THROW(detectFeatures(scene().images[0], options), InvalidOptions);
+}
+
 TEST(FeatureMatching, MutualCheckAndRatioTestRemoveMatches) {
   const PlanarScene& s = scene();
   FeatureMatchingOptions options;

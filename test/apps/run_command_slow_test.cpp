@@ -56,7 +56,8 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_THAT(result.output, HasSubstr("frontend per keyframe (mean ms): undistort "));
 
   EXPECT_EQ(readTrajectory(out + "/trajectory.txt").size(), 6u);
-  for (const char* name : {"curves.ply", "curves.obj", "config.yaml", "overlays/000005.png"}) {
+  for (const char* name :
+       {"curves.ply", "curves.obj", "curves.csv", "config.yaml", "overlays/000005.png"}) {
     EXPECT_TRUE(std::filesystem::exists(out + "/" + name)) << name;
   }
   std::ifstream report_file(out + "/report.json");
@@ -80,6 +81,19 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   }
   EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));
   EXPECT_TRUE(report["ate"]["refined_m"].contains("rmse"));
+  // How far each stage moved the poses, and the curves that pull them most.
+  ASSERT_TRUE(report["pose_stages"].is_array());
+  EXPECT_EQ(report["pose_stages"].size(), 2 + report["reassociation"].size());
+  EXPECT_EQ(report["pose_stages"][0]["stage"], "incremental");
+  EXPECT_LT(report["pose_stages"][0]["moved_rmse"].get<double>(), 1e-12);  // Local BA held them.
+  EXPECT_THAT(result.output, HasSubstr("poses moved from the start (Sim(3) rmse, pose units): "));
+  EXPECT_THAT(result.output, HasSubstr("curves: residual rms median "));
+  EXPECT_EQ(report["curve_statistics"]["most_pull"].size(),
+            std::min<std::size_t>(10, report["counts"]["curves"].get<std::size_t>()));
+  std::ifstream csv(out + "/curves.csv");
+  int csv_lines = 0;
+  for (std::string line; std::getline(csv, line);) ++csv_lines;
+  EXPECT_EQ(csv_lines, 1 + report["counts"]["curves"].get<int>());
   // The sanity checks: the extent, the counts, and each verdict printed as a warning line.
   EXPECT_THAT(result.output, HasSubstr("sanity: scene extent "));
   const nlohmann::json& sanity = report["sanity"];

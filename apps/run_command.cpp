@@ -139,7 +139,8 @@ nlohmann::json stageMotionsJson(const std::vector<StageMotion>& motions, double 
     nlohmann::json stage;
     stage["stage"] = m.name;
     stage["moved_rmse"] = m.moved_rmse;
-    stage["moved_in_scene_scale"] = scene_scale > 0.0 ? m.moved_rmse / scene_scale : 0.0;
+    stage["moved_in_scene_scale"] =
+        scene_scale > 0.0 ? nlohmann::json(m.moved_rmse / scene_scale) : nlohmann::json();
     stage["ate_rmse"] = std::isnan(m.ate_rmse) ? nlohmann::json() : nlohmann::json(m.ate_rmse);
     stages.push_back(stage);
   }
@@ -569,7 +570,7 @@ RunInput RunCommand::loadInput() const {
       std::printf("run: triangulating the tracks of the %zu images at the given poses\n",
                   input.sequence.images.size());
       input.initialisation = triangulateAtPoses(input.sequence, input.frames, initialiser_);
-      input.sightings = initialisedSightings(*input.initialisation);
+      input.sightings = sightingsOfFrames(input.sequence, input.frames, *input.initialisation);
       std::printf("run: %zu points from %d tracks at the given poses\n",
                   input.initialisation->points.size(), input.initialisation->num_tracks);
     }

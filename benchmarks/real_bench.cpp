@@ -713,8 +713,13 @@ void printStartSummary(const std::vector<Row>& rows) {
     if (kind == "truth") {
       const auto colmap = colmap_ate.find(r.set);
       const double reference = colmap == colmap_ate.end() ? std::nan("") : colmap->second;
-      std::printf("start %s: drift ATE %.4g, %.2f x COLMAP's %.4g (target <= 0.5)\n", key.c_str(),
-                  r.ate.rmse, r.ate.rmse / reference, reference);
+      if (std::isnan(reference)) {
+        std::printf("start %s: drift ATE %.4g (no COLMAP row to compare with)\n", key.c_str(),
+                    r.ate.rmse);
+      } else {
+        std::printf("start %s: drift ATE %.4g, %.2f x COLMAP's %.4g (target <= 0.5)\n", key.c_str(),
+                    r.ate.rmse, r.ate.rmse / reference, reference);
+      }
       continue;
     }
     if (r.start_ate > 0.0) ratios[key].push_back(r.ate.rmse / r.start_ate);

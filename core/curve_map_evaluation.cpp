@@ -24,6 +24,15 @@ void CurveMapEvaluationOptions::validate() const {
 
 namespace {
 
+// Pieces of `step` in `length`, at least 1 and at most a million: a runaway curve kilometres long
+// (an old run, or --sanity-drop-curves false) is sampled coarser instead of exhausting memory.
+int boundedCount(double length, double step) {
+  constexpr double kMaxCount = 1e6;
+  const double count = std::ceil(length / step);
+  if (!(count >= 1.0)) return 1;
+  return static_cast<int>(std::min(count, kMaxCount));
+}
+
 struct Segment {
   Eigen::Vector3d a, b;
 };
@@ -48,7 +57,7 @@ class SegmentGrid {
       for (std::size_t i = 1; i < polyline.size(); ++i) {
         const Eigen::Vector3d& a = polyline[i - 1];
         const Eigen::Vector3d& b = polyline[i];
-        const int pieces = std::max(1, static_cast<int>(std::ceil((b - a).norm() / cell_)));
+        const int pieces = boundedCount((b - a).norm(), cell_);
         for (int k = 0; k < pieces; ++k) {
           addPiece({a + (b - a) * (static_cast<double>(k) / pieces),
                     a + (b - a) * (static_cast<double>(k + 1) / pieces)});
@@ -121,7 +130,7 @@ void forEachSample(const Polylines3& polylines, double spacing, Visit&& visit) {
       const Eigen::Vector3d& a = polyline[i - 1];
       const Eigen::Vector3d& b = polyline[i];
       const double length = (b - a).norm();
-      const int parts = std::max(1, static_cast<int>(std::ceil(length / spacing)));
+      const int parts = boundedCount(length, spacing);
       for (int k = 0; k < parts; ++k) {
         visit(a + (b - a) * ((k + 0.5) / parts), length / parts);
       }

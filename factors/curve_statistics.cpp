@@ -91,8 +91,13 @@ std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& i
     double rho[3];
     noise.kernel.evaluate(l.error.squaredNorm() / (noise.sigma * noise.sigma), rho);
     const Vector6d g = rho[1] * l.jacobians[0].transpose() * l.error / (noise.sigma * noise.sigma);
-    auto [entry, inserted] = gradient[c].emplace(pose, g);
-    if (!inserted) entry->second += g;
+    // The gauge's first pose is held by the solver: nothing can pull it anywhere.
+    const bool held =
+        problem.config.isConstant(edge->keys()[0]) || (options.fix_first_pose && pose == 0);
+    if (!held) {
+      auto [entry, inserted] = gradient[c].emplace(pose, g);
+      if (!inserted) entry->second += g;
+    }
     squared[c] += l.error.squaredNorm();
     rows[c] += static_cast<int>(l.error.size());
   }

@@ -15,14 +15,15 @@ namespace curvesfm {
 //    from nearly one direction has a poorly constrained depth);
 //  - its pull on the poses: the norm of its edge factors' part of the cost gradient with respect
 //    to each observing pose, J_pose^T rho'(s) r / sigma^2 with the robust kernel's weight,
-//    summed over those poses (whitened px per tangent unit: rotation and translation mixed, so
-//    a ranking, not a physical quantity), and that as a share of all curves' pull. At a converged
-//    BA the whole gradient is near zero, but each curve's part of it is what the other terms hold
-//    back: a few curves with most of the pull are the ones moving the trajectory.
+//    summed over the poses free to move (whitened px per tangent unit: rotation and translation
+//    mixed, so a ranking, not a physical quantity), and that as a share of all curves' pull. At a
+//    converged BA the whole gradient is near zero, but each curve's part of it is what the other
+//    terms hold back: a few curves with most of the pull are the ones moving the trajectory.
 struct CurveStatistics {
-  int observations = 0;                  ///< (segment, keyframe) observations.
-  int keyframes = 0;                     ///< Distinct keyframes observing it (its track length).
-  int first_keyframe = -1;               ///< The first keyframe observing it.
+  int observations = 0;  ///< (segment, keyframe) observations.
+  int keyframes = 0;     ///< Distinct keyframes observing it (its track length).
+  /// The first keyframe observing it (the pipeline reports the keyframe that started it).
+  int first_keyframe = -1;
   double residual_rms_px = 0.0;          ///< RMS of its sample residuals (px).
   double length = 0.0;                   ///< Arc length (the input's length unit).
   double median_camera_distance = 0.0;   ///< Observing camera centres to its middle (length unit).

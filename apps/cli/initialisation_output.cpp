@@ -135,6 +135,26 @@ std::vector<std::vector<PointSighting>> initialisedSightings(const PointInitiali
   return sightings;
 }
 
+std::vector<std::vector<PointSighting>> sightingsOfFrames(const ImageSequence& sequence,
+                                                          const std::vector<DatasetFrame>& frames,
+                                                          const PointInitialisation& result) {
+  // initialisedSightings() is per registered image, in image order; `frames` may be in another.
+  const std::vector<std::vector<PointSighting>> per_registered = initialisedSightings(result);
+  std::map<std::string, std::size_t> registered_of_image;
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < result.frames.size(); ++i) {
+    if (result.frames[i].cam_from_world)
+      registered_of_image[sequence.images[i].image_path] = next++;
+  }
+  std::vector<std::vector<PointSighting>> sightings;
+  for (const DatasetFrame& frame : frames) {
+    const auto found = registered_of_image.find(frame.image_path);
+    sightings.push_back(found == registered_of_image.end() ? std::vector<PointSighting>()
+                                                           : per_registered[found->second]);
+  }
+  return sightings;
+}
+
 std::vector<StampedPose> initialisedTrajectory(const ImageSequence& sequence,
                                                const PointInitialisation& result) {
   std::vector<StampedPose> trajectory;

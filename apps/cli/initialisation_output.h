@@ -21,8 +21,6 @@ namespace curvesfm {
 PointInitialisation initialiseSequence(const ImageSequence& sequence,
                                        const PointInitialiserOptions& options);
 
-/// The registered frames with their images and poses, in sequence order: the frames `run` feeds
-/// to the curve pipeline.
 /// The initialiser's tracks of every image of `sequence`, triangulated at the poses of `frames`
 /// (PointInitialiser::finishAtPoses; an image is matched to its frame by path, and one without a
 /// frame keeps no pose). Prints progress as initialiseSequence.
@@ -30,6 +28,14 @@ PointInitialisation triangulateAtPoses(const ImageSequence& sequence,
                                        const std::vector<DatasetFrame>& frames,
                                        const PointInitialiserOptions& options);
 
+/// Per frame of `frames` (in their order, matched to the images by path), the points of
+/// `result` it sees: the hybrid graph's input for frames that did not come from the initialiser.
+std::vector<std::vector<PointSighting>> sightingsOfFrames(const ImageSequence& sequence,
+                                                          const std::vector<DatasetFrame>& frames,
+                                                          const PointInitialisation& result);
+
+/// The registered frames with their images and poses, in sequence order: the frames `run` feeds
+/// to the curve pipeline.
 std::vector<DatasetFrame> initialisedFrames(const ImageSequence& sequence,
                                             const PointInitialisation& result);
 

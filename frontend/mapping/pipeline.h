@@ -215,13 +215,14 @@ struct ReassociationRound {
   ScheduleReport global_ba;    ///< The global BA that followed.
 };
 
-/// The result of a run: the refined keyframe trajectory and the global curve map.
 /// The keyframe poses after one stage of the run (issue 14's diagnosis: which stage moves them).
 struct PoseStage {
   /// "incremental" (after the last keyframe's local BA), "global_ba", "reassociation_N".
   std::string name;
   std::vector<Pose3> keyframe_cam_from_world;  ///< Pose units, as keyframe_cam_from_world.
 };
+
+/// The result of a run: the refined keyframe trajectory and the global curve map.
 
 struct PipelineResult {
   std::vector<double> keyframe_timestamps;

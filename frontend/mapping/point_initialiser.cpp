@@ -146,6 +146,9 @@ struct PointInitialiser::State {
   int frames_added = 0;
   PointInitialiser::Progress progress;
   double add_frame_seconds = 0.0;  // Undistortion and tracks, frame by frame.
+  // OpenCV's thread count while tracking: set at the first frame, restored once the tracks are
+  // built (switching it per frame would rebuild OpenCV's thread pool every time).
+  std::optional<TrackingThreads> tracking_threads;
 
   State(const Camera& source, const PointInitialiserOptions& o)
       : options((o.validate(), o)),
@@ -761,7 +764,7 @@ struct PointInitialiser::State {
         << "frame " << frames_added << " is " << image.cols << "x" << image.rows
         << " but the camera is " << camera->width() << "x" << camera->height();
     const Clock::time_point start = Clock::now();
-    const TrackingThreads threads(options.tracking_threads);
+    if (!tracking_threads) tracking_threads.emplace(options.tracking_threads);
     const cv::Mat undistorted = undistorter.undistort(image);
     out.seconds.undistort += secondsSince(start);
     builder.addFrame(undistorted);
@@ -771,10 +774,9 @@ struct PointInitialiser::State {
 
   // Builds the tracks from the frames added (the first half of finish() and finishAtPoses()).
   void buildTracks() {
-    {
-      const TrackingThreads threads(options.tracking_threads);
-      tracks = builder.finish();
-    }
+    if (!tracking_threads) tracking_threads.emplace(options.tracking_threads);
+    tracks = builder.finish();
+    tracking_threads.reset();
     out.num_tracks = static_cast<int>(tracks.tracks.size());
     out.track_stats = tracks.frames;
     for (const FeatureTrackFrameStats& s : tracks.frames) {

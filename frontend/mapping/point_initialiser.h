@@ -112,7 +112,9 @@ struct PointInitialiserOptions {
   int min_merge_points = 20;
   /// OpenCV threads while the tracks are built (count; 0: OpenCV's default, every core). One by
   /// default: issue 13 budgets tracking per core, and two threads gain about a quarter of the
-  /// wall time of SIFT detection for half again its processor time. >= 0.
+  /// wall time of SIFT detection for half again its processor time. The command's --threads sets
+  /// it too unless --points-tracking-threads is given. cv::setNumThreads is process-wide: other
+  /// OpenCV work in the process while the tracks are built runs with this count. >= 0.
   int tracking_threads = 1;
   /// Throws InvalidOptions naming the first field outside its range (also of the nested ones).
   void validate() const;

@@ -801,6 +801,9 @@ PipelineResult Pipeline::finish() {
   // Every curve that reached the global map: the curves the sanity checks judge.
   const int promoted =
       static_cast<int>(impl.map.exportCurves(CurveSelection::kPromoted).ids.size());
+  // A check right after another with no BA between would judge the same map against an extent
+  // rebuilt from fewer curves, and could drop more for nothing having moved.
+  bool checked_since_ba = false;
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
     if (drop) impl.checkCurves(true);
     result.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
@@ -810,9 +813,11 @@ PipelineResult Pipeline::finish() {
     for (int r = 0; r < impl.options.reassociation_rounds; ++r) {
       // Before re-association, so that no runaway curve gains observations.
       if (drop) impl.checkCurves(true);
+      checked_since_ba = drop;
       ReassociationRound round;
       round.added_observations = impl.reassociate();
       if (round.added_observations == 0) break;
+      checked_since_ba = false;
       round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
                                           /*refine_poses=*/true, &result.final_samples);
       ++impl.global_bas;
@@ -820,7 +825,7 @@ PipelineResult Pipeline::finish() {
       result.pose_stages.push_back(impl.poseStage("reassociation_" + std::to_string(r + 1)));
     }
   }
-  impl.checkCurves(drop);
+  if (!checked_since_ba) impl.checkCurves(drop);
   // Back from the scene scale to the unit of the poses given.
   const double unit = impl.unit();
   result.scene_scale = impl.scene_scale;

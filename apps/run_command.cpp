@@ -510,7 +510,7 @@ RunCommand::RunCommand(CLI::App* app) {
       "run",
       "Curve structure from motion on a calibrated image sequence in any layout of the README, "
       "from given initial poses or, without them, from the point-based initialiser's: writes "
-      "trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, report.json, "
+      "trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, curves.csv, report.json, "
       "config.yaml and, with --overlays, the curves drawn on each keyframe; `curvesfm report` "
       "draws them.");
   addConfigFlag(command_);

@@ -51,10 +51,12 @@
 #include "apps/cli/plot_scripts.h"
 #include "benchmarks/support/bench_common.h"
 #include "benchmarks/support/subprocess.h"
+#include "core/angles.h"
 #include "core/colmap_model.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
 #include "core/image_sequence.h"
+#include "core/median.h"
 #include "core/trajectory_evaluation.h"
 
 namespace curvesfm {
@@ -405,9 +407,7 @@ double medianSpacing(const std::vector<StampedPose>& poses) {
     spacing.push_back(
         (poses[i].world_from_cam.translation() - poses[i - 1].world_from_cam.translation()).norm());
   }
-  if (spacing.empty()) return 0.0;
-  std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
-  return spacing[spacing.size() / 2];
+  return upperMedian(spacing);
 }
 
 /// `truth` with every pose perturbed on its own: a world-frame shift of the camera centre and a
@@ -415,7 +415,7 @@ double medianSpacing(const std::vector<StampedPose>& poses) {
 std::vector<StampedPose> noisyStart(const std::vector<StampedPose>& truth,
                                     const BenchOptions& options, int seed) {
   std::mt19937 rng(static_cast<std::uint32_t>(seed));
-  std::normal_distribution<double> rotation(0.0, options.noise_rotation_deg * M_PI / 180.0);
+  std::normal_distribution<double> rotation(0.0, options.noise_rotation_deg * kDegToRad);
   std::normal_distribution<double> shift(0.0,
                                          options.noise_spacing_fraction * medianSpacing(truth));
   std::vector<StampedPose> noisy;

@@ -5,6 +5,8 @@
 #include <map>
 #include <set>
 
+#include "core/angles.h"
+#include "core/median.h"
 #include "graph/key.h"
 
 namespace curvesfm {
@@ -32,18 +34,12 @@ Eigen::Vector3d middleOf(const PolyBezier& curve) {
   return curve.evaluate(i, t - i);
 }
 
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
-
 // Camera distances and the widest ray angle at `point` over the centres given.
 void viewingGeometry(const std::vector<Eigen::Vector3d>& centres, const Eigen::Vector3d& point,
                      CurveStatistics* s) {
   std::vector<double> distances;
   for (const Eigen::Vector3d& c : centres) distances.push_back((c - point).norm());
-  s->median_camera_distance = median(distances);
+  s->median_camera_distance = upperMedian(distances);
   double widest = 0.0;
   for (std::size_t a = 0; a < centres.size(); ++a) {
     for (std::size_t b = a + 1; b < centres.size(); ++b) {
@@ -52,7 +48,7 @@ void viewingGeometry(const std::vector<Eigen::Vector3d>& centres, const Eigen::V
       widest = std::max(widest, std::atan2(ra.cross(rb).norm(), ra.dot(rb)));
     }
   }
-  s->triangulation_angle_deg = widest * 180.0 / M_PI;
+  s->triangulation_angle_deg = widest * kRadToDeg;
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "core/check.h"
 #include "core/clock.h"
 #include "core/errors.h"
+#include "core/median.h"
 #include "core/point_triangulation.h"
 #include "core/similarity_alignment.h"
 #include "factors/pose_variables.h"
@@ -121,14 +122,6 @@ struct Model {
     points[p].frames.clear();
   }
 };
-
-// The median of `values` (copied); 0 when empty.
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const auto mid = values.begin() + values.size() / 2;
-  std::nth_element(values.begin(), mid, values.end());
-  return *mid;
-}
 
 Eigen::Vector3d centreOf(const Pose3& cam_from_world) {
   return cam_from_world.inverseTranslation();
@@ -385,7 +378,7 @@ struct PointInitialiser::State {
     std::vector<double> flow;
     flow.reserve(shared.size());
     for (int t : shared) flow.push_back((pixelOf(t, a) - pixelOf(t, b)).norm());
-    return median(flow);
+    return upperMedian(flow);
   }
 
   std::optional<PairCandidate> findInitialPair(const std::vector<bool>& available,
@@ -453,7 +446,7 @@ struct PointInitialiser::State {
     for (const MapPoint& p : model->points) {
       if (p.alive()) depths.push_back((*model->poses[model->pair.first] * p.position).z());
     }
-    const double scale = median(depths);
+    const double scale = upperMedian(depths);
     if (!(scale > 0.0)) return;
     for (MapPoint& p : model->points) p.position /= scale;
     for (auto& pose : model->poses) {
@@ -624,8 +617,8 @@ struct PointInitialiser::State {
       if (static_cast<int>(seen) < options.min_merge_points || seen <= most) continue;
       frame = f;
       most = seen;
-      source_depth = median(s);
-      target_depth = median(t);
+      source_depth = upperMedian(s);
+      target_depth = upperMedian(t);
     }
     if (frame < 0 || !(source_depth > 0.0) || !(target_depth > 0.0)) return std::nullopt;
     // cam_from_target * t == scale * cam_from_source for the shared camera.
@@ -664,7 +657,7 @@ struct PointInitialiser::State {
     std::vector<double> residuals;
     for (std::size_t i = 0; i < from.size(); ++i)
       residuals.push_back((*first * from[i] - to[i]).norm());
-    const double bound = 3.0 * median(residuals);
+    const double bound = 3.0 * upperMedian(residuals);
     std::vector<Eigen::Vector3d> inlier_from, inlier_to;
     for (std::size_t i = 0; i < from.size(); ++i) {
       if (residuals[i] <= bound) {

@@ -6,6 +6,7 @@
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/median.h"
 #include "core/similarity_alignment.h"
 
 namespace curvesfm {
@@ -119,8 +120,7 @@ PoseMove largestPoseMove(const std::vector<Pose3>& initial_cam_from_world,
   if (!initial.allFinite() || !refined.allFinite()) return move;
   std::vector<double> spacings;
   for (int j = 1; j < n; ++j) spacings.push_back((initial.col(j) - initial.col(j - 1)).norm());
-  std::nth_element(spacings.begin(), spacings.begin() + spacings.size() / 2, spacings.end());
-  move.spacing = spacings[spacings.size() / 2];
+  move.spacing = upperMedian(spacings);
   if (!(move.spacing > 0.0) || !hasSpreadForScale(refined) || !hasSpreadForScale(initial)) {
     move.spacing = 0.0;
     return move;

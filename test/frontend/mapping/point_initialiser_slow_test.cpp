@@ -1,6 +1,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "core/errors.h"
 #include "core/trajectory_evaluation.h"
 #include "frontend/mapping/point_initialiser.h"
 #include "sim/planar_scene.h"
@@ -96,6 +97,17 @@ TEST(PointInitialiser, TriangulatesTheTracksAtGivenPosesWithoutMovingThem) {
   std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
   EXPECT_LT(heights[heights.size() / 2], 1e-2);
   EXPECT_EQ(result.scale_convention, "the given poses' unit");
+}
+
+TEST(PointInitialiserOptions, ANegativeTrackingThreadCountIsRefusedByName) {
+  PointInitialiserOptions options;
+  options.tracking_threads = -1;
+  try {
+    options.validate();
+    ADD_FAILURE() << "tracking_threads -1 accepted";
+  } catch (const InvalidOptions& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("tracking_threads"));
+  }
 }
 
 TEST(PointInitialiser, ATexturelessSequenceFailsWithAReason) {

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <optional>
@@ -32,6 +33,8 @@ struct RunInput {
   std::optional<PointInitialisation> initialisation;  // When the initialiser ran.
   // Per frame, the initialiser's points it sees (the hybrid graph's input); empty otherwise.
   std::vector<std::vector<PointSighting>> sightings;
+  // Per frame, the pose the frontend works at (--diagnose-frontend-poses); empty otherwise.
+  std::vector<Pose3> frontend_poses;
 };
 
 namespace {
@@ -70,7 +73,8 @@ std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const RunInput& input)
     const KeyframeStats s = pipeline->addFrame(
         {frame.timestamp, loadFrameImage(frame, input.sequence.camera),
          frame.initial_cam_from_world,
-         input.sightings.empty() ? std::vector<PointSighting>{} : input.sightings[i]});
+         input.sightings.empty() ? std::vector<PointSighting>{} : input.sightings[i],
+         input.frontend_poses.empty() ? std::optional<Pose3>() : input.frontend_poses[i]});
     if (s.keyframe_index >= 0) printProgress(s, n);
     stats.push_back(s);
   }
@@ -530,6 +534,9 @@ RunCommand::RunCommand(CLI::App* app) {
                 "With given initial poses, triangulate the initialiser's tracks at them (points "
                 "for the depth ranges and --ba-points)")
       ->capture_default_str();
+  c->add_option("--diagnose-frontend-poses", frontend_poses_path_,
+                "Diagnosis: lift and register curves at these poses (TUM or COLMAP model, e.g. the "
+                "ground truth), then start global BA from the initial poses");
   c->add_flag("--overlays", overlays_,
               "Write OUT/overlays/NNNNNN.png: the final curves drawn on keyframe NNNNNN");
   c->add_option("--export-samples", export_samples_per_segment_,
@@ -556,7 +563,29 @@ nlohmann::json RunCommand::runOptionsJson() const {
   options["export_samples_per_segment"] = export_samples_per_segment_;
   options["max_dt"] = max_dt_;
   options["points_at_given_poses"] = points_at_given_poses_;
+  options["diagnose_frontend_poses"] = frontend_poses_path_;
   return options;
+}
+
+// The --diagnose-frontend-poses pose of every frame of `input`, matched by timestamp as the
+// initial poses are; IoError naming the file if a frame has none.
+std::vector<Pose3> RunCommand::frontendPoses(const RunInput& input) const {
+  std::string source;
+  const std::vector<StampedPose> poses =
+      readInitialPoses(frontend_poses_path_, input.sequence, &source);
+  std::map<std::string, Pose3> by_image;
+  for (const DatasetFrame& f : framesWithPoses(input.sequence, poses, max_dt_, source)) {
+    by_image.emplace(f.image_path, f.initial_cam_from_world);
+  }
+  std::vector<Pose3> frontend;
+  for (const DatasetFrame& f : input.frames) {
+    const auto it = by_image.find(f.image_path);
+    if (it == by_image.end()) {
+      throw IoError(frontend_poses_path_, "has no pose within --max-dt of image " + f.image_path);
+    }
+    frontend.push_back(it->second);
+  }
+  return frontend;
 }
 
 RunInput RunCommand::loadInput() const {
@@ -566,6 +595,7 @@ RunInput RunCommand::loadInput() const {
       readInitialPoses(init_poses_path_, input.sequence, &input.init_poses_source);
   if (!poses.empty()) {
     input.frames = framesWithPoses(input.sequence, poses, max_dt_, input.init_poses_source);
+    if (!frontend_poses_path_.empty()) input.frontend_poses = frontendPoses(input);
     if (points_at_given_poses_ && input.frames.size() >= 2) {
       std::printf("run: triangulating the tracks of the %zu images at the given poses\n",
                   input.sequence.images.size());

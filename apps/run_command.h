@@ -38,6 +38,7 @@ class RunCommand {
  private:
   /// The images with their initial poses: read, or found by the point initialiser.
   RunInput loadInput() const;
+  std::vector<Pose3> frontendPoses(const RunInput& input) const;
   /// Every option in force, for report.json: the table's and the run's own.
   nlohmann::json runOptionsJson() const;
 
@@ -52,6 +53,7 @@ class RunCommand {
   /// With given initial poses, the initialiser's tracks are triangulated at them: points for the
   /// keyframes' depth ranges and for --ba-points, as the initialiser's own run has.
   bool points_at_given_poses_ = true;
+  std::string frontend_poses_path_;  // Diagnosis: --diagnose-frontend-poses.
   ImageSequenceOptions sequence_;
   PointInitialiserOptions initialiser_;
   PipelineOptions options_;

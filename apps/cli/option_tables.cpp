@@ -366,6 +366,17 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
       .number("reassociation_rounds", "reassociation-rounds", &o->reassociation_rounds,
               "After global BA: rounds of re-registering every curve in every keyframe, each "
               "followed by global BA (0: none)")
+      .boolean("reassociation_skip_explained", "reassociation-skip-explained",
+               &o->reassociation_skip_explained,
+               "Re-association leaves edges that curves observed in a keyframe already explain")
+      .number("reassociation_max_edge_distance_px", "reassociation-max-edge-distance",
+              &o->reassociation_max_edge_distance_px,
+              "Largest mean edge distance of a re-associated segment (px; 0: "
+              "--match-max-edge-distance)")
+      .number("reassociation_max_viewing_angle_deg", "reassociation-max-viewing-angle",
+              &o->reassociation_max_viewing_angle_deg,
+              "Largest viewing angle of a re-associated segment to its earlier views (deg; 0: "
+              "--match-max-viewing-angle)")
       .number("depth_reference_candidates", "depth-reference-candidates",
               &o->depth_reference_candidates, "Recent keyframes considered as depth references")
       .boolean("track_keyframe_pose", "track-keyframe-pose", &o->track_keyframe_pose,

@@ -25,8 +25,10 @@ struct Keyframe {
   Pose3 given_cam_from_world;    // As given, in pose units (for the result).
   Pose3 initial_cam_from_world;  // In the scene scale, as every pose below.
   Pose3 cam_from_world;          // Current estimate.
-  cv::Mat image_bgr;             // Undistorted.
-  cv::Mat grey;                  // Undistorted.
+  // PipelineFrame::frontend_cam_from_world, in pose units, when given.
+  std::optional<Pose3> given_frontend_cam_from_world;
+  cv::Mat image_bgr;  // Undistorted.
+  cv::Mat grey;       // Undistorted.
   std::shared_ptr<const NearestEdgeField> field;
   std::vector<PointSighting> points;  // The hybrid graph's points it sees.
 };
@@ -236,6 +238,14 @@ void PipelineOptions::validate() const {
   require(depth_reference_candidates >= 1, "depth_reference_candidates", depth_reference_candidates,
           ">= 1");
   require(reassociation_rounds >= 0, "reassociation_rounds", reassociation_rounds, ">= 0");
+  require(std::isfinite(reassociation_max_edge_distance_px) &&
+              reassociation_max_edge_distance_px >= 0.0,
+          "reassociation_max_edge_distance_px", reassociation_max_edge_distance_px,
+          "must be finite and >= 0");
+  require(
+      reassociation_max_viewing_angle_deg >= 0.0 && reassociation_max_viewing_angle_deg <= 180.0,
+      "reassociation_max_viewing_angle_deg", reassociation_max_viewing_angle_deg,
+      "must be in [0, 180]");
   require(std::isfinite(explained_radius_px) && explained_radius_px >= 0.0, "explained_radius_px",
           explained_radius_px, "must be finite and >= 0");
 }
@@ -262,6 +272,7 @@ struct Pipeline::Impl {
                     KeyframeStats* stats);
   void registerMap(int k, cv::Mat* explained, KeyframeStats* stats);
   int reassociate();
+  cv::Mat explainedEdges(int k, int samples, int thickness) const;
   std::vector<int> depthReferences(int k, const std::vector<EdgeChain>& chains) const;
   EpipolarDepthOptions depthOptions(int k) const;
   PoseStage poseStage(const std::string& name) const;
@@ -298,6 +309,9 @@ struct Pipeline::Impl {
   std::vector<ImplausibleCurve> implausible;
   SceneExtent extent;
   int global_bas = 0;
+  // Some frame came with PipelineFrame::frontend_cam_from_world: global BA starts from the
+  // initial poses instead of those.
+  bool frontend_poses_given = false;
 };
 
 // Derives the scene scale from the first frame that moved away from frame 0 (see
@@ -316,7 +330,8 @@ void Pipeline::Impl::updateSceneScale(const Pose3& initial_cam_from_world) {
   scene_scale = distance;
   for (Keyframe& keyframe : keyframes) {
     keyframe.initial_cam_from_world = toSceneScale(keyframe.given_cam_from_world, distance);
-    keyframe.cam_from_world = keyframe.initial_cam_from_world;
+    keyframe.cam_from_world = toSceneScale(
+        keyframe.given_frontend_cam_from_world.value_or(keyframe.given_cam_from_world), distance);
   }
 }
 
@@ -433,21 +448,60 @@ int Pipeline::Impl::reassociate() {
   for (const int id : map.curvesIn(CurveState::kDisabled)) {
     if (map.curve(id).promoted) ids.push_back(id);
   }
+  const int samples = 2 * options.correspondence.samples_per_segment + 1;
+  const int thickness = 2 * static_cast<int>(std::ceil(options.explained_radius_px)) + 1;
+  CorrespondenceOptions checks = options.correspondence;
+  if (options.reassociation_max_edge_distance_px > 0.0) {
+    checks.max_mean_edge_distance_px = options.reassociation_max_edge_distance_px;
+  }
+  if (options.reassociation_max_viewing_angle_deg > 0.0) {
+    checks.max_viewing_angle_deg = options.reassociation_max_viewing_angle_deg;
+  }
   for (int k = 0; k < static_cast<int>(keyframes.size()); ++k) {
     const KeyframeView view = viewOf(keyframes[k], *camera);
+    cv::Mat explained;
+    if (options.reassociation_skip_explained) explained = explainedEdges(k, samples, thickness);
     for (const int id : ids) {
       const MapCurve& curve = map.curve(id);
       for (int i = 0; i < curve.curve.numSegments(); ++i) {
         if (curve.segments[i].observedIn(k)) continue;
-        const CorrespondenceVerdict verdict = registerSegment(
-            curve.curve.segment(i), view, curve.segments[i].history(), options.correspondence);
+        const BezierSegmentParams segment = curve.curve.segment(i);
+        std::vector<cv::Point> polyline;
+        if (!explained.empty()) {
+          polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera, samples);
+          if (fractionOnMask(polyline, explained) > 0.5) continue;
+        }
+        const CorrespondenceVerdict verdict =
+            registerSegment(segment, view, curve.segments[i].history(), checks);
         if (!verdict.registered) continue;
         map.addObservation(id, i, registration(id, i, k, verdict));
+        if (!explained.empty() && !polyline.empty()) {
+          cv::polylines(explained, std::vector<std::vector<cv::Point>>{polyline}, false,
+                        cv::Scalar(255), thickness);
+        }
         ++added;
       }
     }
   }
   return added;
+}
+
+// The pixels of keyframe k that the segments observed there explain: their projections at the
+// current poses and curves, drawn `thickness` px wide.
+cv::Mat Pipeline::Impl::explainedEdges(int k, int samples, int thickness) const {
+  cv::Mat explained = cv::Mat::zeros(camera->height(), camera->width(), CV_8UC1);
+  std::vector<std::vector<cv::Point>> polylines;
+  for (int id = 0; id < map.size(); ++id) {
+    const MapCurve& curve = map.curve(id);
+    for (int i = 0; i < curve.curve.numSegments(); ++i) {
+      if (!curve.segments[i].observedIn(k)) continue;
+      std::vector<cv::Point> polyline =
+          projectSegment(curve.curve.segment(i), keyframes[k].cam_from_world, *camera, samples);
+      if (!polyline.empty()) polylines.push_back(std::move(polyline));
+    }
+  }
+  cv::polylines(explained, polylines, false, cv::Scalar(255), thickness);
+  return explained;
 }
 
 // The keyframe poses now, in the unit of the poses given; a pose nothing moved is returned
@@ -732,6 +786,11 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   scaled.initial_cam_from_world = toSceneScale(frame.initial_cam_from_world, unit());
   const cv::Mat edges = prepareKeyframe(scaled, &chains, &stats);
   keyframes.back().given_cam_from_world = frame.initial_cam_from_world;
+  if (frame.frontend_cam_from_world) {
+    keyframes.back().given_frontend_cam_from_world = frame.frontend_cam_from_world;
+    keyframes.back().cam_from_world = toSceneScale(*frame.frontend_cam_from_world, unit());
+    frontend_poses_given = true;
+  }
 
   const Clock::time_point start = Clock::now();
   if (options.track_keyframe_pose && k > 0) trackPose(&keyframes[k]);
@@ -804,6 +863,10 @@ PipelineResult Pipeline::finish() {
   // A check right after another with no BA between would judge the same map against an extent
   // rebuilt from fewer curves, and could drop more for nothing having moved.
   bool checked_since_ba = false;
+  if (impl.frontend_poses_given) {
+    for (Keyframe& keyframe : impl.keyframes)
+      keyframe.cam_from_world = keyframe.initial_cam_from_world;
+  }
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
     if (drop) impl.checkCurves(true);
     result.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,
@@ -833,7 +896,8 @@ PipelineResult Pipeline::finish() {
     result.keyframe_timestamps.push_back(keyframe.timestamp);
     result.keyframe_initial_cam_from_world.push_back(keyframe.given_cam_from_world);
   }
-  result.keyframe_cam_from_world = result.pose_stages.back().keyframe_cam_from_world;
+  // Not the last stage's: with frontend poses and no global BA, that is the frontend's.
+  result.keyframe_cam_from_world = impl.poseStage("result").keyframe_cam_from_world;
   for (const PolyBezier& curve : impl.map.exportCurves(CurveSelection::kPromoted).curves) {
     result.curves.push_back(scaledCurve(curve, unit));
   }

@@ -3,6 +3,7 @@
 #include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,19 @@ struct PipelineOptions {
   /// lifted over a short, noisy baseline projects too far from its edges a few keyframes on).
   /// Stops early when a round adds no observation. >= 0; 0 turns it off.
   int reassociation_rounds = 3;
+  /// Re-association leaves a keyframe's edges to the curves already observed there: a segment
+  /// whose projection lies mostly (over half its samples) within explained_radius_px of the
+  /// projection of a segment observed in that keyframe is not registered there, nor are two
+  /// re-associated segments on one edge. A segment hidden behind another curve's surface then
+  /// cannot take that curve's edge.
+  bool reassociation_skip_explained = true;
+  /// Largest mean edge distance of a re-associated segment (px; see
+  /// CorrespondenceOptions::max_mean_edge_distance_px); 0 takes correspondence's.
+  double reassociation_max_edge_distance_px = 0.0;
+  /// Largest angle between a re-associated view and the mean of the segment's earlier viewing
+  /// directions (deg; see CorrespondenceOptions::max_viewing_angle_deg); 0 takes
+  /// correspondence's.
+  double reassociation_max_viewing_angle_deg = 0.0;
   /// Reference keyframes considered for the depth of a new keyframe's edges (the most recent
   /// ones, ranked by rankReferenceFrames). >= 1.
   int depth_reference_candidates = 4;
@@ -146,6 +160,11 @@ struct PipelineFrame {
   /// The points of setPoints() this frame sees; used when it becomes a keyframe and
   /// ba.points is on.
   std::vector<PointSighting> points = {};
+  /// Diagnosis only (issue 14): the pose at which the frontend lifts and registers curves for
+  /// this frame instead of the starting guess; global BA still starts from
+  /// initial_cam_from_world. With the truth here and a perturbed start, a run separates a map
+  /// built at the start's errors from an optimiser that cannot leave them.
+  std::optional<Pose3> frontend_cam_from_world = std::nullopt;
 };
 
 /// What happened to one frame (a progress line and a report.json entry).

@@ -80,6 +80,14 @@ TEST_F(RunCommandTest, InitialPosesThatMatchNoImageNameBothFiles) {
   EXPECT_THAT(result.output, HasSubstr("none of its 2 poses"));
 }
 
+TEST_F(RunCommandTest, FrontendPosesMissingAnImageNameTheFileAndTheImage) {
+  writeTinyDataset();
+  std::ofstream(path("frontend.txt")) << "1.0 0 0 0 0 0 0 1\n1.1 0 0 0 0 0 0 1\n";
+  expectOneLineError(run("--diagnose-frontend-poses " + path("frontend.txt")),
+                     "IoError: " + path("frontend.txt") +
+                         ": has no pose within --max-dt of image " + path("rgb/2.png"));
+}
+
 TEST_F(RunCommandTest, WithoutInitialPosesTheInitialiserRunsAndSaysWhyItFoundNone) {
   writeTinyDataset();  // Three flat 8x8 images: no texture, no tracks.
   std::filesystem::remove(path("init_poses.txt"));

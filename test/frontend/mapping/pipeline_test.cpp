@@ -22,5 +22,19 @@ TEST(PipelineOptions, ValidateNamesTheStageAndField) {
   EXPECT_FALSE(PipelineOptions{}.local_ba_refines_poses);
 }
 
+TEST(PipelineOptions, ValidateChecksTheReassociationGates) {
+  PipelineOptions options;
+  options.reassociation_max_edge_distance_px = -1.0;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<InvalidOptions>(
+                  testing::HasSubstr("PipelineOptions.reassociation_max_edge_distance_px")));
+  options = {};
+  options.reassociation_max_viewing_angle_deg = 181.0;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<InvalidOptions>(
+                  testing::HasSubstr("PipelineOptions.reassociation_max_viewing_angle_deg")));
+  EXPECT_TRUE(PipelineOptions{}.reassociation_skip_explained);
+}
+
 }  // namespace
 }  // namespace curvesfm

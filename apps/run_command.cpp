@@ -168,28 +168,27 @@ void writeCurveStatisticsCsv(const std::string& path, const std::vector<CurveSta
   std::ofstream out(path);
   if (!out) throw IoError(path, "cannot open for writing");
   out << "curve,first_keyframe,keyframes,observations,length,median_camera_distance,"
-         "triangulation_angle_deg,residual_rms_px,pose_pull,pose_pull_share\n";
+         "triangulation_angle_deg,residual_rms_px,pose_pull,pose_pull_share,last_keyframe,"
+         "worst_keyframe\n";
   for (std::size_t c = 0; c < stats.size(); ++c) {
     const CurveStatistics& s = stats[c];
     out << c << "," << s.first_keyframe << "," << s.keyframes << "," << s.observations << ","
         << s.length << "," << s.median_camera_distance << "," << s.triangulation_angle_deg << ","
-        << s.residual_rms_px << "," << s.pose_pull << "," << s.pose_pull_share << "\n";
+        << s.residual_rms_px << "," << s.pose_pull << "," << s.pose_pull_share << ","
+        << s.last_keyframe << "," << s.worst_keyframe << "\n";
   }
   if (!out) throw IoError(path, "cannot write");
 }
 
-// The `count` curves ranked highest by `key`, as JSON (index into curves.obj / curves.csv).
-template <class Key>
-nlohmann::json worstCurves(const std::vector<CurveStatistics>& stats, std::size_t count, Key key) {
-  std::vector<std::size_t> order(stats.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return key(stats[a]) > key(stats[b]); });
+// The worst curves of `ranking`, as JSON (index into curves.obj / curves.csv).
+nlohmann::json worstCurvesJson(const std::vector<CurveStatistics>& stats, CurveRanking ranking) {
   nlohmann::json worst = nlohmann::json::array();
-  for (std::size_t i = 0; i < std::min(count, order.size()); ++i) {
-    const CurveStatistics& s = stats[order[i]];
-    worst.push_back({{"curve", order[i]},
+  for (std::size_t c : worstCurves(stats, ranking, kWorstCurvesListed)) {
+    const CurveStatistics& s = stats[c];
+    worst.push_back({{"curve", c},
                      {"first_keyframe", s.first_keyframe},
+                     {"last_keyframe", s.last_keyframe},
+                     {"worst_keyframe", s.worst_keyframe},
                      {"keyframes", s.keyframes},
                      {"length", s.length},
                      {"median_camera_distance", s.median_camera_distance},
@@ -201,12 +200,9 @@ nlohmann::json worstCurves(const std::vector<CurveStatistics>& stats, std::size_
 }
 
 nlohmann::json curveStatisticsJson(const std::vector<CurveStatistics>& stats) {
-  constexpr std::size_t kWorst = 10;
   return {{"file", "curves.csv"},
-          {"most_pull",
-           worstCurves(stats, kWorst, [](const CurveStatistics& s) { return s.pose_pull_share; })},
-          {"highest_residual",
-           worstCurves(stats, kWorst, [](const CurveStatistics& s) { return s.residual_rms_px; })}};
+          {"most_pull", worstCurvesJson(stats, CurveRanking::kPull)},
+          {"highest_residual", worstCurvesJson(stats, CurveRanking::kResidual)}};
 }
 
 // One line: the residual spread and how concentrated the pull on the poses is.
@@ -232,18 +228,13 @@ void printCurveStatistics(const std::vector<CurveStatistics>& stats) {
 // ---------------------------------------------------------------------------------------------
 // Output.
 
-int writeOverlays(const std::string& dir, const Pipeline& pipeline, const PipelineResult& r,
-                  const CurveOverlayOptions& options) {
-  fs::create_directories(dir);
+OverlayScene overlayScene(const Pipeline& pipeline, const PipelineResult& r) {
+  OverlayScene scene{
+      pipeline.undistortedCamera(), {}, r.keyframe_cam_from_world, r.curves, r.curve_statistics};
   for (std::size_t k = 0; k < r.keyframe_cam_from_world.size(); ++k) {
-    cv::Mat image = pipeline.keyframeImage(static_cast<int>(k)).clone();
-    drawCurves(&image, r.curves, pipeline.undistortedCamera(), r.keyframe_cam_from_world[k],
-               options);
-    char name[32];
-    std::snprintf(name, sizeof(name), "%06zu.png", k);
-    writeImage(joinPath(dir, name), image);
+    scene.keyframe_images.push_back(pipeline.keyframeImage(static_cast<int>(k)));
   }
-  return static_cast<int>(r.keyframe_cam_from_world.size());
+  return scene;
 }
 
 nlohmann::json frameToJson(const KeyframeStats& s) {
@@ -515,8 +506,8 @@ RunCommand::RunCommand(CLI::App* app) {
       "Curve structure from motion on a calibrated image sequence in any layout of the README, "
       "from given initial poses or, without them, from the point-based initialiser's: writes "
       "trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, curves.csv, report.json, "
-      "config.yaml and, with --overlays, the curves drawn on each keyframe; `curvesfm report` "
-      "draws them.");
+      "config.yaml and, with --overlays, the curves drawn on each keyframe coloured by a "
+      "statistic and the worst curves one by one; `curvesfm report` draws them.");
   addConfigFlag(command_);
   CLI::App* c = command_;
   c->add_option("--dataset", dataset_dir_,
@@ -538,14 +529,19 @@ RunCommand::RunCommand(CLI::App* app) {
                 "Diagnosis: lift and register curves at these poses (TUM or COLMAP model, e.g. the "
                 "ground truth), then start global BA from the initial poses");
   c->add_flag("--overlays", overlays_,
-              "Write OUT/overlays/NNNNNN.png: the final curves drawn on keyframe NNNNNN");
+              "Write OUT/overlays/NNNNNN.png, the final curves drawn on keyframe NNNNNN coloured "
+              "by --overlay-colour-by with a legend, and OUT/worst_curves/: the 10 curves of "
+              "highest residual and the 10 pulling the poses most, each highlighted on the "
+              "keyframe where its residual is largest, indexed in worst_curves.md");
   c->add_option("--export-samples", export_samples_per_segment_,
                 "Samples per segment of the curves in curves.ply and curves.obj")
       ->capture_default_str();
   addImageSequenceOptions(&table_, &sequence_);
   addPointInitialiserOptions(&table_, &initialiser_, "/points");
   addPipelineOptions(&table_, &options_, "/pipeline");
-  addCurveOverlayOptions(&table_, &overlay_, {"/overlay", "overlay-", "Overlays", ""});
+  const OptionPlace overlay_place{"/overlay", "overlay-", "Overlays", ""};
+  addCurveOverlayOptions(&table_, &overlay_, overlay_place);
+  addOverlayColouringOptions(&table_, &overlay_colouring_, overlay_place);
   table_.addFlags(c);
 }
 
@@ -653,8 +649,14 @@ int RunCommand::run() const {
   writeCurvesObj(joinPath(out_dir_, "curves.obj"), result.curves, export_samples_per_segment_);
   writeCurveStatisticsCsv(joinPath(out_dir_, "curves.csv"), result.curve_statistics);
   writeConfigYaml(joinPath(out_dir_, "config.yaml"), *command_);
-  const int overlays =
-      overlays_ ? writeOverlays(joinPath(out_dir_, "overlays"), pipeline, result, overlay_) : 0;
+  int overlays = 0;
+  int worst_curve_images = 0;
+  if (overlays_) {
+    const OverlayScene scene = overlayScene(pipeline, result);
+    overlays = writeOverlays(joinPath(out_dir_, "overlays"), scene, overlay_,
+                             overlay_colouring_.colour_by);
+    worst_curve_images = writeWorstCurves(joinPath(out_dir_, "worst_curves"), scene, overlay_);
+  }
 
   nlohmann::json frames = nlohmann::json::array();
   for (const KeyframeStats& s : result.frames) frames.push_back(frameToJson(s));
@@ -685,7 +687,8 @@ int RunCommand::run() const {
          {"segments", totalSegments(result.curves)},
          {"curves_started", growth.started},
          {"curves_extended", growth.extended},
-         {"overlays", overlays}}},
+         {"overlays", overlays},
+         {"worst_curve_images", worst_curve_images}}},
        {"frames", frames},
        {"global_ba", scheduleReportToJson(result.global_ba)},
        {"global_ba_cost_by_type", globalCostsToJson(result.global_ba)},
@@ -706,7 +709,8 @@ int RunCommand::run() const {
       "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, curves.csv, "
       "report.json, "
       "config.yaml%s%s)\n",
-      out_dir_.c_str(), input.initialisation ? ", points.ply" : "", overlays_ ? ", overlays/" : "");
+      out_dir_.c_str(), input.initialisation ? ", points.ply" : "",
+      overlays_ ? ", overlays/, worst_curves/" : "");
   std::fflush(stdout);  // The summary first, then why the run failed, if it did.
   if (result.curves.empty() && result.sanity.droppedCurves() > 0) {
     std::fprintf(stderr,

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "apps/cli/curve_overlays.h"
 #include "apps/cli/options_table.h"
 #include "core/image_sequence.h"
 #include "frontend/image/curve_overlay.h"
@@ -20,7 +21,8 @@ struct RunInput;
 /// global BA and writes trajectory.txt, trajectory_initial.txt (the keyframes' initial poses),
 /// curves.ply, curves.obj, report.json (incl. the undistorted camera and the per-pose ATE that
 /// `curvesfm report` draws), config.yaml (the flags in force, for --config) and, with
-/// --overlays, the curves reprojected onto each keyframe. With DIR/groundtruth.txt it prints the
+/// --overlays, the curves reprojected onto each keyframe, coloured by a statistic, and the worst
+/// curves one by one (apps/cli/curve_overlays.h). With DIR/groundtruth.txt it prints the
 /// ATE (Sim(3)) of the initial and the refined keyframe trajectory. Every PipelineOptions field
 /// is a flag (and so a --config key), prefixed by its stage.
 class RunCommand {
@@ -58,7 +60,9 @@ class RunCommand {
   PointInitialiserOptions initialiser_;
   PipelineOptions options_;
   CurveOverlayOptions overlay_;
-  OptionsTable table_;  ///< Rows point into options_ and overlay_: the command is not copied.
+  OverlayColouringOptions overlay_colouring_;
+  /// Rows point into the options structs above: the command is not copied.
+  OptionsTable table_;
 };
 
 }  // namespace curvesfm

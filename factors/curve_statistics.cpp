@@ -51,6 +51,34 @@ void viewingGeometry(const std::vector<Eigen::Vector3d>& centres, const Eigen::V
   s->triangulation_angle_deg = widest * kRadToDeg;
 }
 
+// Sum of squared residuals over some samples.
+struct SquaredResiduals {
+  double squared = 0.0;
+  int rows = 0;
+
+  void add(const Eigen::VectorXd& error) {
+    squared += error.squaredNorm();
+    rows += static_cast<int>(error.size());
+  }
+  double rms() const { return rows > 0 ? std::sqrt(squared / rows) : 0.0; }
+};
+
+// The residual RMS over every keyframe, and the keyframe where it is largest.
+void residualsOverKeyframes(const std::map<int, SquaredResiduals>& per_keyframe,
+                            CurveStatistics* s) {
+  SquaredResiduals total;
+  double worst_rms = -1.0;
+  for (const auto& [keyframe, residuals] : per_keyframe) {
+    total.squared += residuals.squared;
+    total.rows += residuals.rows;
+    if (residuals.rms() > worst_rms) {
+      worst_rms = residuals.rms();
+      s->worst_keyframe = keyframe;
+    }
+  }
+  s->residual_rms_px = total.rms();
+}
+
 }  // namespace
 
 std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& input,
@@ -66,6 +94,7 @@ std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& i
     CurveStatistics& s = stats[c];
     s.keyframes = static_cast<int>(keyframes_of[c].size());
     s.first_keyframe = keyframes_of[c].empty() ? -1 : *keyframes_of[c].begin();
+    s.last_keyframe = keyframes_of[c].empty() ? -1 : *keyframes_of[c].rbegin();
     s.length = arcLength(input.curves[c]);
     std::vector<Eigen::Vector3d> centres;
     for (int j : keyframes_of[c]) centres.push_back(input.cam_from_world[j].inverseTranslation());
@@ -74,9 +103,8 @@ std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& i
   if (input.observations.empty()) return stats;
 
   const CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options);
-  std::vector<double> squared(n, 0.0);
-  std::vector<int> rows(n, 0);
-  std::vector<std::map<int, Vector6d>> gradient(n);  // Per curve, per pose.
+  std::vector<std::map<int, SquaredResiduals>> residuals(n);  // Per curve, per keyframe.
+  std::vector<std::map<int, Vector6d>> gradient(n);           // Per curve, per pose.
   for (const auto& factor : problem.graph) {
     const auto* edge = dynamic_cast<const CurveReprojectionFactor*>(factor.get());
     if (edge == nullptr) continue;
@@ -94,12 +122,11 @@ std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& i
       auto [entry, inserted] = gradient[c].emplace(pose, g);
       if (!inserted) entry->second += g;
     }
-    squared[c] += l.error.squaredNorm();
-    rows[c] += static_cast<int>(l.error.size());
+    residuals[c][pose].add(l.error);
   }
   double total_pull = 0.0;
   for (std::size_t c = 0; c < n; ++c) {
-    if (rows[c] > 0) stats[c].residual_rms_px = std::sqrt(squared[c] / rows[c]);
+    residualsOverKeyframes(residuals[c], &stats[c]);
     for (const auto& [pose, g] : gradient[c]) stats[c].pose_pull += g.norm();
     total_pull += stats[c].pose_pull;
   }

@@ -24,6 +24,10 @@ struct CurveStatistics {
   int keyframes = 0;     ///< Distinct keyframes observing it (its track length).
   /// The first keyframe observing it (the pipeline reports the keyframe that started it).
   int first_keyframe = -1;
+  int last_keyframe = -1;  ///< The last keyframe observing it.
+  /// The observing keyframe where its residual RMS is largest (the first of equals; -1 when no
+  /// sample was evaluated): where an overlay shows it worst.
+  int worst_keyframe = -1;
   double residual_rms_px = 0.0;          ///< RMS of its sample residuals (px).
   double length = 0.0;                   ///< Arc length (the input's length unit).
   double median_camera_distance = 0.0;   ///< Observing camera centres to its middle (length unit).

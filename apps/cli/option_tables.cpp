@@ -418,10 +418,20 @@ void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* o, const O
             const Eigen::Vector3d bgr = parseVector3(text, "CurveOverlayOptions", "colour");
             o->colour = cv::Scalar(bgr.x(), bgr.y(), bgr.z());
           },
-          "Colour of the drawn curves, blue, green, red in [0, 255]")
+          "Colour of the curves with --overlay-colour-by none, and of the faint curves in "
+          "worst_curves/: blue, green, red in [0, 255]")
       .number("thickness_px", "thickness", &o->thickness_px, "Line thickness (px)")
       .number("point_radius_px", "point-radius", &o->point_radius_px,
               "Radius of the dots at segment ends (px); 0 draws none");
+}
+
+void addOverlayColouringOptions(OptionsTable* table, OverlayColouringOptions* o,
+                                const OptionPlace& place) {
+  table->group(o, "OverlayColouringOptions", place.path, place.prefix, place.heading)
+      .enumeration("colour_by", "colour-by", &o->colour_by,
+                   "Statistic colouring each curve of the overlays over a fixed range, with a "
+                   "legend (residual rms 0-3 px; track length 2-20 keyframes; share of the pull "
+                   "on the poses 0.01-10 %, log scale; none: every curve in --overlay-colour)");
 }
 
 void addPointTrackerOptions(OptionsTable* table, PointTrackerOptions* o, const OptionPlace& place) {

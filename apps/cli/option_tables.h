@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "apps/cli/curve_overlays.h"
 #include "apps/cli/options_table.h"
 #include "core/camera.h"
 #include "core/curve_map_evaluation.h"
@@ -56,6 +57,9 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* options, const std
 void addSanityOptions(OptionsTable* table, SanityOptions* options, const OptionPlace& place);
 void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* options,
                             const OptionPlace& place);
+/// How run colours the overlays (`--overlay-colour-by`); it shares the drawing's place.
+void addOverlayColouringOptions(OptionsTable* table, OverlayColouringOptions* options,
+                                const OptionPlace& place);
 /// The point-based initialiser (init, and run without initial poses): every flag starts with
 /// "points-" (e.g. --points-klt-grid-cols, --points-pnp-min-inliers) so that it never meets the
 /// curve pipeline's flags in `run`.

@@ -43,13 +43,14 @@ std::vector<std::vector<cv::Point>> projectRuns(const std::vector<Eigen::Vector3
   return runs;
 }
 
-void drawPoints(cv::Mat* image, const PolyBezier& curve, const Camera& camera,
-                const Pose3& cam_from_world, const CurveOverlayOptions& options) {
+void drawPoints(cv::Mat* image, const PolyBezier& curve, const cv::Scalar& colour,
+                const Camera& camera, const Pose3& cam_from_world,
+                const CurveOverlayOptions& options) {
   for (const Eigen::Vector3d& q : curve.points()) {
     Eigen::Vector2d pixel;
     if (!camera.project(cam_from_world * q, &pixel) || !camera.isInImage(pixel)) continue;
     cv::circle(*image, toFixedPoint(pixel), static_cast<int>(options.point_radius_px * kShiftScale),
-               options.colour, 1, cv::LINE_AA, kShiftBits);
+               colour, 1, cv::LINE_AA, kShiftBits);
   }
 }
 
@@ -67,20 +68,31 @@ void CurveOverlayOptions::validate() const {
 CurveOverlayCounts drawCurves(cv::Mat* image_bgr, const std::vector<PolyBezier>& curves,
                               const Camera& camera, const Pose3& cam_from_world,
                               const CurveOverlayOptions& options) {
+  return drawCurves(image_bgr, curves, std::vector<cv::Scalar>(curves.size(), options.colour),
+                    camera, cam_from_world, options);
+}
+
+CurveOverlayCounts drawCurves(cv::Mat* image_bgr, const std::vector<PolyBezier>& curves,
+                              const std::vector<cv::Scalar>& colours_bgr, const Camera& camera,
+                              const Pose3& cam_from_world, const CurveOverlayOptions& options) {
   options.validate();
   CURVESFM_CHECK(image_bgr && image_bgr->type() == CV_8UC3 && image_bgr->cols == camera.width() &&
                  image_bgr->rows == camera.height())
       << "expected a CV_8UC3 image of " << camera.width() << "x" << camera.height();
+  CURVESFM_CHECK(colours_bgr.size() == curves.size())
+      << colours_bgr.size() << " colours for " << curves.size() << " curves";
   CurveOverlayCounts counts;
-  for (const PolyBezier& curve : curves) {
+  for (std::size_t c = 0; c < curves.size(); ++c) {
     const auto runs =
-        projectRuns(curve.sample(options.samples_per_segment), camera, cam_from_world, &counts);
+        projectRuns(curves[c].sample(options.samples_per_segment), camera, cam_from_world, &counts);
     for (const std::vector<cv::Point>& run : runs) {
       if (run.size() < 2) continue;
-      cv::polylines(*image_bgr, run, false, options.colour, options.thickness_px, cv::LINE_AA,
+      cv::polylines(*image_bgr, run, false, colours_bgr[c], options.thickness_px, cv::LINE_AA,
                     kShiftBits);
     }
-    if (options.point_radius_px > 0) drawPoints(image_bgr, curve, camera, cam_from_world, options);
+    if (options.point_radius_px > 0) {
+      drawPoints(image_bgr, curves[c], colours_bgr[c], camera, cam_from_world, options);
+    }
   }
   return counts;
 }

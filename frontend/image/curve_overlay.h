@@ -14,7 +14,7 @@ struct CurveOverlayOptions {
   /// Samples per cubic segment of the drawn polyline (PolyBezier::sample); more give smoother
   /// curves on screen. In [1, 1000].
   int samples_per_segment = 16;
-  /// Line colour (B, G, R; 0-255 each).
+  /// Line colour (B, G, R; 0-255 each) when every curve takes the same one.
   cv::Scalar colour = cv::Scalar(0, 255, 0);
   /// Line thickness (px). In [1, 50].
   int thickness_px = 1;
@@ -42,5 +42,12 @@ struct CurveOverlayCounts {
 CurveOverlayCounts drawCurves(cv::Mat* image_bgr, const std::vector<PolyBezier>& curves,
                               const Camera& camera, const Pose3& cam_from_world,
                               const CurveOverlayOptions& options = {});
+
+/// As above, each curve in its own colour: `colours_bgr[c]` for `curves[c]` (one per curve;
+/// CheckError otherwise), e.g. a statistic of the curve through colourMapBgr (colour_map.h);
+/// options.colour is not used.
+CurveOverlayCounts drawCurves(cv::Mat* image_bgr, const std::vector<PolyBezier>& curves,
+                              const std::vector<cv::Scalar>& colours_bgr, const Camera& camera,
+                              const Pose3& cam_from_world, const CurveOverlayOptions& options = {});
 
 }  // namespace curvesfm

@@ -73,6 +73,30 @@ class RunCommandTest : public ::testing::Test {
     writeTrajectory(path("init_poses.txt"), poses);
   }
 
+  // Six 240 x 180 views of ringsTexture() over a 15 degree arc with perturbed initial poses:
+  // a run on it takes well under a second with shortPlanarFlags(). Returns the folder.
+  std::string writeShortPlanarDataset() const {
+    PlanarSceneOptions options;
+    options.num_frames = 6;
+    options.arc_degrees = 15.0;
+    options.width = 240;
+    options.height = 180;
+    options.fx = options.fy = 200.0;
+    options.cx = 119.5;
+    options.cy = 89.5;
+    options.intensity_noise = 0.01;
+    options.init_noise_model = InitNoiseModel::kIndependent;
+    options.init_noise_translation = 0.005;
+    options.init_noise_rotation_deg = 0.2;
+    const std::string dataset = path("planar");
+    writePlanarDataset(dataset, makePlanarScene(ringsTexture(), options));
+    return dataset;
+  }
+  // Every frame a keyframe, and a short global BA.
+  static std::string shortPlanarFlags() {
+    return " --map-keyframe-translation 0 --map-keyframe-rotation 0 --global-ba-max-iterations 10";
+  }
+
   CommandResult run(const std::string& extra = "") const {
     return runCurvesfm("run --dataset " + folder_.string() + " --out " + path("out") + " " + extra);
   }

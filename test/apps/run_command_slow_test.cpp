@@ -7,13 +7,11 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
 #include "apps/cli/report_json.h"
 #include "core/dataset_io.h"
-#include "sim/planar_scene.h"
 #include "test/apps/run_command_fixture.h"
 #include "test/support/run_executable.h"
 
@@ -24,30 +22,14 @@ using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
 using testing::CommandResult;
-using testing::ringsTexture;
 using testing::RunCommandTest;
 using testing::runCurvesfm;
 
 TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
-  PlanarSceneOptions options;
-  options.num_frames = 6;
-  options.arc_degrees = 15.0;
-  options.width = 240;
-  options.height = 180;
-  options.fx = options.fy = 200.0;
-  options.cx = 119.5;
-  options.cy = 89.5;
-  options.intensity_noise = 0.01;
-  options.init_noise_model = InitNoiseModel::kIndependent;
-  options.init_noise_translation = 0.005;
-  options.init_noise_rotation_deg = 0.2;
-  const std::string dataset = path("planar");
-  writePlanarDataset(dataset, makePlanarScene(ringsTexture(), options));
+  const std::string dataset = writeShortPlanarDataset();
   const std::string out = path("planar_out");
-  const std::string flags =
-      " --map-keyframe-translation 0 --map-keyframe-rotation 0 --global-ba-max-iterations 10";
-  const CommandResult result =
-      runCurvesfm("run --dataset " + dataset + " --out " + out + " --overlays" + flags);
+  const CommandResult result = runCurvesfm("run --dataset " + dataset + " --out " + out +
+                                           " --overlays" + shortPlanarFlags());
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_THAT(result.output, HasSubstr("frame 1/6 keyframe 0: curves "));
   EXPECT_THAT(result.output, HasSubstr("frame 6/6 keyframe 5: curves "));

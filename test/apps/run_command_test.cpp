@@ -6,8 +6,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -135,11 +137,43 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   result = run("--local-ba-strategy sideways");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--local-ba-strategy"));
+  result = run("--overlays --overlay-colour-by length");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--overlay-colour-by"));
+  EXPECT_THAT(result.output, HasSubstr("\"length\": expected one of none, residual, track, pull"));
   EXPECT_EQ(runCurvesfm("run --out " + path("out")).exit_code, 2);
   EXPECT_FALSE(std::filesystem::exists(path("out")));
 }
 
-// A short orbit over a planar photo, every frame a keyframe: all outputs are written and read
-// back, and the configuration written beside them runs again.
+TEST_F(RunCommandTest, OverlaysColourTheCurvesAndDrawTheWorstOnesUnderTheirDocumentedNames) {
+  const std::string out = path("planar_out");
+  const CommandResult result =
+      runCurvesfm("run --dataset " + writeShortPlanarDataset() + " --out " + out +
+                  " --overlays --overlay-colour-by track" + shortPlanarFlags());
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr(", overlays/, worst_curves/)"));
+  std::ifstream report_file(out + "/report.json");
+  const nlohmann::json report = nlohmann::json::parse(report_file);
+  EXPECT_EQ(report["options"]["overlay"]["colour_by"], "track");
+  EXPECT_TRUE(std::filesystem::exists(out + "/overlays/000005.png"));
+  // Each worst curve drawn on its worst keyframe, under the name the README gives, and indexed.
+  const nlohmann::json& statistics = report["curve_statistics"];
+  ASSERT_FALSE(statistics["highest_residual"].empty());
+  std::ifstream index_file(out + "/worst_curves/worst_curves.md");
+  const std::string index((std::istreambuf_iterator<char>(index_file)),
+                          std::istreambuf_iterator<char>());
+  for (const char* ranking : {"residual", "pull"}) {
+    const nlohmann::json& worst =
+        statistics[std::string(ranking) == "residual" ? "highest_residual" : "most_pull"][0];
+    char name[64];
+    std::snprintf(name, sizeof(name), "%s_01_curve_%04d_kf_%04d.png", ranking,
+                  worst["curve"].get<int>(), worst["worst_keyframe"].get<int>());
+    EXPECT_TRUE(std::filesystem::exists(out + "/worst_curves/" + name)) << name;
+    EXPECT_THAT(index, HasSubstr(std::string("[") + name + "](" + name + ")"));
+  }
+  EXPECT_EQ(report["counts"]["worst_curve_images"].get<std::size_t>(),
+            statistics["highest_residual"].size() + statistics["most_pull"].size());
+}
+
 }  // namespace
 }  // namespace curvesfm

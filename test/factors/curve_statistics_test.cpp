@@ -50,17 +50,48 @@ TEST(CurveStatistics, GivesTheTrackOfEachCurveFromItsObservations) {
   const std::vector<CurveStatistics> stats = curveStatistics(input, {});
   std::vector<int> observations(input.curves.size(), 0);
   std::vector<int> first(input.curves.size(), 1 << 30);
+  std::vector<int> last(input.curves.size(), -1);
   for (const SegmentObservation& o : input.observations) {
     ++observations[o.curve];
     first[o.curve] = std::min(first[o.curve], o.keyframe);
+    last[o.curve] = std::max(last[o.curve], o.keyframe);
   }
   for (std::size_t c = 0; c < stats.size(); ++c) {
     EXPECT_EQ(stats[c].observations, observations[c]);
     EXPECT_EQ(stats[c].first_keyframe, observations[c] > 0 ? first[c] : -1);
+    EXPECT_EQ(stats[c].last_keyframe, last[c]);
     EXPECT_LE(stats[c].keyframes, 4);
     EXPECT_GE(stats[c].triangulation_angle_deg, 0.0);
     EXPECT_LT(stats[c].triangulation_angle_deg, 180.0);
   }
+}
+
+TEST(CurveStatistics, FindsTheKeyframeWhereEachCurveIsWorst) {
+  const CurveScene scene = smallScene();
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene, SceneStart::kTruth);
+  // Keyframe 2 moved 5 cm sideways: every curve it observes is furthest off its edges there.
+  const int moved = 2;
+  const Pose3& pose = input.cam_from_world[moved];
+  input.cam_from_world[moved] =
+      Pose3(pose.rotation(), pose.translation() + Eigen::Vector3d(0.05, 0.0, 0.0));
+  std::vector<bool> seen_by_moved(input.curves.size(), false);
+  for (const SegmentObservation& o : input.observations) {
+    if (o.keyframe == moved) seen_by_moved[o.curve] = true;
+  }
+  const std::vector<CurveStatistics> stats = curveStatistics(input, {});
+  int checked = 0;
+  for (std::size_t c = 0; c < stats.size(); ++c) {
+    if (stats[c].observations == 0) {
+      EXPECT_EQ(stats[c].worst_keyframe, -1) << "curve " << c;
+      continue;
+    }
+    EXPECT_GE(stats[c].worst_keyframe, stats[c].first_keyframe) << "curve " << c;
+    EXPECT_LE(stats[c].worst_keyframe, stats[c].last_keyframe) << "curve " << c;
+    if (!seen_by_moved[c]) continue;
+    EXPECT_EQ(stats[c].worst_keyframe, moved) << "curve " << c;
+    ++checked;
+  }
+  EXPECT_GT(checked, 0);
 }
 
 }  // namespace

@@ -23,6 +23,7 @@ using ::testing::HasSubstr;
 struct AllOptions {
   PipelineOptions pipeline;
   CurveOverlayOptions overlay;
+  OverlayColouringOptions overlay_colouring;
   PointInitialiserOptions points;
   ImageSequenceOptions sequence;
   CurveSceneOptions curve_scene;
@@ -42,6 +43,8 @@ std::vector<OptionsTable> commandTables(AllOptions* o) {
   std::vector<OptionsTable> tables(6);
   addPipelineOptions(&tables[0], &o->pipeline, "/pipeline");
   addCurveOverlayOptions(&tables[0], &o->overlay, {"/overlay", "overlay-", "Overlays", ""});
+  addOverlayColouringOptions(&tables[0], &o->overlay_colouring,
+                             {"/overlay", "overlay-", "Overlays", ""});
   addPointInitialiserOptions(&tables[0], &o->points, "/points");
   addImageSequenceOptions(&tables[0], &o->sequence);
   addCurveSceneOptions(&tables[1], &o->curve_scene, {"/scene", "", "Scene", ""});

@@ -5,19 +5,13 @@
 #include <opencv2/core.hpp>
 
 #include "core/errors.h"
+#include "test/support/cameras.h"
 
 namespace curvesfm {
 namespace {
 
-Camera smallCamera() {
-  CameraIntrinsics k;
-  k.fx = k.fy = 100.0;
-  k.cx = 79.5;
-  k.cy = 59.5;
-  k.width = 160;
-  k.height = 120;
-  return Camera(k);
-}
+// Principal point (79.5, 59.5).
+Camera smallCamera() { return testing::centredPinhole(100.0, 160, 120); }
 
 // A straight one-segment curve from a to b (arms of a third: uniform speed).
 PolyBezier line(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -63,6 +57,26 @@ TEST(CurveOverlay, SkipsSamplesBehindTheCameraWithoutDrawingAcrossTheImage) {
   // Nothing left of or above the principal point: the visible part lies right of and below it.
   EXPECT_EQ(greenPixels(image(cv::Rect(0, 0, 79, 120))), 0);
   EXPECT_EQ(greenPixels(image(cv::Rect(0, 0, 160, 59))), 0);
+}
+
+TEST(CurveOverlay, DrawsEachCurveInItsOwnColour) {
+  const Camera camera = smallCamera();
+  cv::Mat image(120, 160, CV_8UC3, cv::Scalar(0, 0, 0));
+  CurveOverlayOptions options;
+  options.point_radius_px = 0;
+  // Rows 39.5 and 79.5 at depth 2 m; options.colour (green) must not appear.
+  const std::vector<PolyBezier> curves = {line({-0.5, -0.4, 2}, {0.5, -0.4, 2}),
+                                          line({-0.5, 0.4, 2}, {0.5, 0.4, 2})};
+  drawCurves(&image, curves, {cv::Scalar(0, 0, 255), cv::Scalar(255, 0, 0)}, camera, Pose3(),
+             options);
+  const cv::Vec3b upper = image.at<cv::Vec3b>(39, 80) + image.at<cv::Vec3b>(40, 80);
+  const cv::Vec3b lower = image.at<cv::Vec3b>(79, 80) + image.at<cv::Vec3b>(80, 80);
+  EXPECT_GT(upper[2], 0);
+  EXPECT_EQ(upper[0], 0);
+  EXPECT_GT(lower[0], 0);
+  EXPECT_EQ(lower[2], 0);
+  EXPECT_EQ(greenPixels(image), 0);
+  EXPECT_THROW(drawCurves(&image, curves, {cv::Scalar(0, 0, 255)}, camera, Pose3()), CheckError);
 }
 
 TEST(CurveOverlay, RejectsBadOptionsAndImages) {

@@ -272,6 +272,7 @@ struct Pipeline::Impl {
                     KeyframeStats* stats);
   void registerMap(int k, cv::Mat* explained, KeyframeStats* stats);
   int reassociate();
+  int reassociateIn(int k, const std::vector<int>& ids, const CorrespondenceOptions& checks);
   cv::Mat explainedEdges(int k, int samples, int thickness) const;
   std::vector<int> depthReferences(int k, const std::vector<EdgeChain>& chains) const;
   EpipolarDepthOptions depthOptions(int k) const;
@@ -441,15 +442,13 @@ void Pipeline::Impl::registerMap(int k, cv::Mat* explained, KeyframeStats* stats
 }
 
 // Registers every promoted curve's segments in every keyframe that does not observe them yet,
-// with the same four checks, at the refined poses and curves. Returns the observations added.
+// with the same four checks (tightened by the reassociation_* options), at the refined poses and
+// curves. Returns the observations added.
 int Pipeline::Impl::reassociate() {
-  int added = 0;
   std::vector<int> ids = map.curvesIn(CurveState::kGlobal);
   for (const int id : map.curvesIn(CurveState::kDisabled)) {
     if (map.curve(id).promoted) ids.push_back(id);
   }
-  const int samples = 2 * options.correspondence.samples_per_segment + 1;
-  const int thickness = 2 * static_cast<int>(std::ceil(options.explained_radius_px)) + 1;
   CorrespondenceOptions checks = options.correspondence;
   if (options.reassociation_max_edge_distance_px > 0.0) {
     checks.max_mean_edge_distance_px = options.reassociation_max_edge_distance_px;
@@ -457,42 +456,55 @@ int Pipeline::Impl::reassociate() {
   if (options.reassociation_max_viewing_angle_deg > 0.0) {
     checks.max_viewing_angle_deg = options.reassociation_max_viewing_angle_deg;
   }
+  int added = 0;
   for (int k = 0; k < static_cast<int>(keyframes.size()); ++k) {
-    const KeyframeView view = viewOf(keyframes[k], *camera);
-    cv::Mat explained;
-    if (options.reassociation_skip_explained) explained = explainedEdges(k, samples, thickness);
-    for (const int id : ids) {
-      const MapCurve& curve = map.curve(id);
-      for (int i = 0; i < curve.curve.numSegments(); ++i) {
-        if (curve.segments[i].observedIn(k)) continue;
-        const BezierSegmentParams segment = curve.curve.segment(i);
-        std::vector<cv::Point> polyline;
-        if (!explained.empty()) {
-          polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera, samples);
-          if (fractionOnMask(polyline, explained) > 0.5) continue;
-        }
-        const CorrespondenceVerdict verdict =
-            registerSegment(segment, view, curve.segments[i].history(), checks);
-        if (!verdict.registered) continue;
-        map.addObservation(id, i, registration(id, i, k, verdict));
-        if (!explained.empty() && !polyline.empty()) {
-          cv::polylines(explained, std::vector<std::vector<cv::Point>>{polyline}, false,
-                        cv::Scalar(255), thickness);
-        }
-        ++added;
+    added += reassociateIn(k, ids, checks);
+  }
+  return added;
+}
+
+// Re-association in keyframe k of the segments of curves `ids` it does not observe yet.
+int Pipeline::Impl::reassociateIn(int k, const std::vector<int>& ids,
+                                  const CorrespondenceOptions& checks) {
+  const int samples = 2 * options.correspondence.samples_per_segment + 1;
+  const int thickness = 2 * static_cast<int>(std::ceil(options.explained_radius_px)) + 1;
+  const KeyframeView view = viewOf(keyframes[k], *camera);
+  cv::Mat explained;
+  if (options.reassociation_skip_explained) explained = explainedEdges(k, samples, thickness);
+  int added = 0;
+  for (const int id : ids) {
+    const MapCurve& curve = map.curve(id);
+    for (int i = 0; i < curve.curve.numSegments(); ++i) {
+      if (curve.segments[i].observedIn(k)) continue;
+      const BezierSegmentParams segment = curve.curve.segment(i);
+      std::vector<cv::Point> polyline;
+      if (!explained.empty()) {
+        polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera, samples);
+        if (fractionOnMask(polyline, explained) > 0.5) continue;
       }
+      const CorrespondenceVerdict verdict =
+          registerSegment(segment, view, curve.segments[i].history(), checks);
+      if (!verdict.registered) continue;
+      map.addObservation(id, i, registration(id, i, k, verdict));
+      if (!polyline.empty()) {
+        cv::polylines(explained, std::vector<std::vector<cv::Point>>{polyline}, false,
+                      cv::Scalar(255), thickness);
+      }
+      ++added;
     }
   }
   return added;
 }
 
 // The pixels of keyframe k that the segments observed there explain: their projections at the
-// current poses and curves, drawn `thickness` px wide.
+// current poses and curves, drawn `thickness` px wide. Curves the sanity checks dropped explain
+// nothing.
 cv::Mat Pipeline::Impl::explainedEdges(int k, int samples, int thickness) const {
   cv::Mat explained = cv::Mat::zeros(camera->height(), camera->width(), CV_8UC1);
   std::vector<std::vector<cv::Point>> polylines;
   for (int id = 0; id < map.size(); ++id) {
     const MapCurve& curve = map.curve(id);
+    if (curve.state == CurveState::kImplausible) continue;
     for (int i = 0; i < curve.curve.numSegments(); ++i) {
       if (!curve.segments[i].observedIn(k)) continue;
       std::vector<cv::Point> polyline =

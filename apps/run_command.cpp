@@ -526,8 +526,9 @@ RunCommand::RunCommand(CLI::App* app) {
                 "for the depth ranges and --ba-points)")
       ->capture_default_str();
   c->add_option("--diagnose-frontend-poses", frontend_poses_path_,
-                "Diagnosis: lift and register curves at these poses (TUM or COLMAP model, e.g. the "
-                "ground truth), then start global BA from the initial poses");
+                "Diagnosis: lift and register curves at these poses (TUM or COLMAP model, in the "
+                "initial poses' frame and unit, e.g. the ground truth beside a perturbed copy of "
+                "it), then start global BA from the initial poses");
   c->add_flag("--overlays", overlays_,
               "Write OUT/overlays/NNNNNN.png, the final curves drawn on keyframe NNNNNN coloured "
               "by --overlay-colour-by with a legend, and OUT/worst_curves/: the 10 curves of "
@@ -601,6 +602,13 @@ RunInput RunCommand::loadInput() const {
                   input.initialisation->points.size(), input.initialisation->num_tracks);
     }
     return input;
+  }
+  if (!frontend_poses_path_.empty()) {
+    // The initialiser's frame and unit are its own: poses given beside it would not match.
+    throw InvalidOptions("run", "diagnose-frontend-poses", frontend_poses_path_,
+                         "needs initial poses in the same frame (--init-poses or "
+                         "DATASET/init_poses.txt), not the point initialiser's")
+        .withFlag("diagnose-frontend-poses");
   }
   std::printf(
       "run: no initial poses (no --init-poses, no %s/init_poses.txt): running the point "

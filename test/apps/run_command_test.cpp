@@ -90,6 +90,17 @@ TEST_F(RunCommandTest, FrontendPosesMissingAnImageNameTheFileAndTheImage) {
                          ": has no pose within --max-dt of image " + path("rgb/2.png"));
 }
 
+TEST_F(RunCommandTest, FrontendPosesNeedGivenInitialPoses) {
+  writeTinyDataset();
+  std::filesystem::remove(path("init_poses.txt"));
+  const CommandResult result = run("--diagnose-frontend-poses " + path("frontend.txt"));
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_THAT(result.output,
+              HasSubstr("InvalidOptions: --diagnose-frontend-poses = " + path("frontend.txt") +
+                        ": needs initial poses in the same frame"));
+  EXPECT_FALSE(std::filesystem::exists(path("out")));
+}
+
 TEST_F(RunCommandTest, WithoutInitialPosesTheInitialiserRunsAndSaysWhyItFoundNone) {
   writeTinyDataset();  // Three flat 8x8 images: no texture, no tracks.
   std::filesystem::remove(path("init_poses.txt"));

@@ -111,8 +111,13 @@ struct PipelineOptions {
   /// whose projection lies mostly (over half its samples) within explained_radius_px of the
   /// projection of a segment observed in that keyframe is not registered there, nor are two
   /// re-associated segments on one edge. A segment hidden behind another curve's surface then
-  /// cannot take that curve's edge.
-  bool reassociation_skip_explained = true;
+  /// cannot take that curve's edge. Off by default: on real scenes it lowered the drift of a
+  /// start at the truth (Pavilion 4.41 -> 3.47 mm), but on the planar bench, where the curve a
+  /// re-associated segment would meet is mostly its own duplicate, started after the segment's
+  /// curve was lost, it kept tracks short and 5 of 6 cases ended 20-50 % worse (LinuxLogo 1.53
+  /// -> 2.31 mm; docs/benchmarks.md). Telling an occluder (nearer) from a duplicate (as near)
+  /// is the next step.
+  bool reassociation_skip_explained = false;
   /// Largest mean edge distance of a re-associated segment (px; see
   /// CorrespondenceOptions::max_mean_edge_distance_px); 0 takes correspondence's.
   double reassociation_max_edge_distance_px = 0.0;

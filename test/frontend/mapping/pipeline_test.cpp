@@ -33,7 +33,7 @@ TEST(PipelineOptions, ValidateChecksTheReassociationGates) {
   EXPECT_THAT([&] { options.validate(); },
               testing::ThrowsMessage<InvalidOptions>(
                   testing::HasSubstr("PipelineOptions.reassociation_max_viewing_angle_deg")));
-  EXPECT_TRUE(PipelineOptions{}.reassociation_skip_explained);
+  EXPECT_FALSE(PipelineOptions{}.reassociation_skip_explained);
 }
 
 }  // namespace

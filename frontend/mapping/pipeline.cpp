@@ -310,9 +310,6 @@ struct Pipeline::Impl {
   std::vector<ImplausibleCurve> implausible;
   SceneExtent extent;
   int global_bas = 0;
-  // Some frame came with PipelineFrame::frontend_cam_from_world: global BA starts from the
-  // initial poses instead of those.
-  bool frontend_poses_given = false;
 };
 
 // Derives the scene scale from the first frame that moved away from frame 0 (see
@@ -801,7 +798,6 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   if (frame.frontend_cam_from_world) {
     keyframes.back().given_frontend_cam_from_world = frame.frontend_cam_from_world;
     keyframes.back().cam_from_world = toSceneScale(*frame.frontend_cam_from_world, unit());
-    frontend_poses_given = true;
   }
 
   const Clock::time_point start = Clock::now();
@@ -875,9 +871,11 @@ PipelineResult Pipeline::finish() {
   // A check right after another with no BA between would judge the same map against an extent
   // rebuilt from fewer curves, and could drop more for nothing having moved.
   bool checked_since_ba = false;
-  if (impl.frontend_poses_given) {
-    for (Keyframe& keyframe : impl.keyframes)
+  // Global BA starts from the initial poses, not from those the frontend was given.
+  for (Keyframe& keyframe : impl.keyframes) {
+    if (keyframe.given_frontend_cam_from_world) {
       keyframe.cam_from_world = keyframe.initial_cam_from_world;
+    }
   }
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
     if (drop) impl.checkCurves(true);

@@ -68,6 +68,11 @@ struct BenchOptions {
   int samples_per_segment = 10;  ///< s: s + 1 residuals per (segment, keyframe) pair; 1..64.
   int fixed_segments = 500;      ///< Segments of the keyframe sweep; >= segments_per_curve.
   int fixed_keyframes = 20;      ///< Keyframes of the segment sweep; >= 2.
+  /// The sweeps' points; empty lists keep the defaults (10..200 keyframes, 100..5,000 segments).
+  std::vector<int> keyframe_sweep;
+  std::vector<int> segment_sweep;
+  /// OptimizerOptions::curve_blocks: one solver block per curve (false: one per variable).
+  bool curve_blocks = true;
 };
 
 struct Configuration {
@@ -77,10 +82,12 @@ struct Configuration {
 };
 
 std::vector<Configuration> sweepConfigurations(const BenchOptions& options) {
-  const std::vector<int> keyframes =
+  std::vector<int> keyframes =
       options.quick ? std::vector<int>{4, 8} : std::vector<int>{10, 25, 50, 100, 200};
-  const std::vector<int> segments =
+  std::vector<int> segments =
       options.quick ? std::vector<int>{50, 100} : std::vector<int>{100, 500, 1000, 2500, 5000};
+  if (!options.keyframe_sweep.empty()) keyframes = options.keyframe_sweep;
+  if (!options.segment_sweep.empty()) segments = options.segment_sweep;
   const int fixed_segments = options.quick ? 100 : options.fixed_segments;
   const int fixed_keyframes = options.quick ? 6 : options.fixed_keyframes;
   std::vector<Configuration> configurations;
@@ -246,6 +253,7 @@ SchedulerOptions fixedIterationSolve(const BenchOptions& options) {
       parseEnumName<LinearSolver>(options.linear_solver, "OptimizerOptions", "linear_solver");
   optimizer.max_iterations = options.iterations;
   optimizer.num_threads = options.threads;
+  optimizer.curve_blocks = options.curve_blocks;
   optimizer.function_tolerance = 1e-300;
   optimizer.gradient_tolerance = 1e-300;
   optimizer.parameter_tolerance = 1e-300;
@@ -524,10 +532,11 @@ void printSettings(const BenchOptions& options) {
   std::printf(
       "# scaling_bench: images %dx%d, 360 deg orbit (r = 3 m) in a 12 x 3 x 12 m room, %d "
       "segments per curve, %d samples per observation; joint solves of %d LM iterations (median of "
-      "%d), %s, %d Ceres thread(s); each configuration in its own process\n\n",
+      "%d), %s, %d Ceres thread(s), %s; each configuration in its own process\n\n",
       scene.intrinsics.width, scene.intrinsics.height, options.segments_per_curve,
       options.samples_per_segment + 1, options.iterations, options.repeats,
-      options.linear_solver.c_str(), options.threads);
+      options.linear_solver.c_str(), options.threads,
+      options.curve_blocks ? "a block per curve" : "a block per variable");
 }
 
 int run(const BenchOptions& options) {
@@ -594,6 +603,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--fixed-keyframes", options.fixed_keyframes, "Keyframes of the segment sweep")
       ->check(CLI::Range(2, 10000))
+      ->capture_default_str();
+  app.add_option("--keyframe-sweep", options.keyframe_sweep,
+                 "Keyframe counts of the keyframe sweep (default 10 25 50 100 200)")
+      ->check(CLI::Range(2, 10000));
+  app.add_option("--segment-sweep", options.segment_sweep,
+                 "Segment counts of the segment sweep (default 100 500 1000 2500 5000)")
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--curve-blocks", options.curve_blocks,
+                 "One solver block per curve (false: one per variable, the old layout)")
       ->capture_default_str();
   return curvesfm::bench::parseAndRun(app, argc, argv, [&] { return curvesfm::run(options); });
 }

@@ -107,7 +107,14 @@ PreparedScene prepare(const NamedScene& named) {
   return prepared;
 }
 
-Run solve(const PreparedScene& prepared, const Config& config, int max_iterations) {
+struct BenchOptions {
+  std::string out = "bench_out/strategy";  ///< Output folder (created).
+  bool quick = false;                      ///< One scene and a reduced sweep (smoke test).
+  int max_iterations = 100;                ///< Ceres iterations per solve.
+  bool curve_blocks = true;                ///< OptimizerOptions::curve_blocks.
+};
+
+Run solve(const PreparedScene& prepared, const Config& config, const BenchOptions& options) {
   CurveBundleAdjustmentOptions ba;
   ba.kernel = config.kernel;
   ba.lambda1 = config.lambda1;
@@ -116,7 +123,8 @@ Run solve(const PreparedScene& prepared, const Config& config, int max_iteration
   SchedulerOptions scheduler;
   scheduler.strategy = config.strategy;
   scheduler.optimizer.linear_solver = config.solver;
-  scheduler.optimizer.max_iterations = max_iterations;
+  scheduler.optimizer.max_iterations = options.max_iterations;
+  scheduler.optimizer.curve_blocks = options.curve_blocks;
 
   const auto start = bench::Clock::now();
   CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(prepared.input, ba);
@@ -241,12 +249,6 @@ void writeSummary(const std::vector<Aggregate>& sweep, const std::vector<Run>& e
   }
 }
 
-struct BenchOptions {
-  std::string out = "bench_out/strategy";  ///< Output folder (created).
-  bool quick = false;                      ///< One scene and a reduced sweep (smoke test).
-  int max_iterations = 100;                ///< Ceres iterations per solve.
-};
-
 int run(const BenchOptions& options) {
   const auto start = bench::Clock::now();
   const std::filesystem::path out(options.out);
@@ -262,7 +264,7 @@ int run(const BenchOptions& options) {
   const int total = static_cast<int>(configs.size() * scenes.size());
   for (const Config& config : configs) {
     for (const PreparedScene& scene : scenes) {
-      runs.push_back(solve(scene, config, options.max_iterations));
+      runs.push_back(solve(scene, config, options));
       if (++done % 20 == 0 || done == total) {
         std::fprintf(stderr, "\r%d / %d runs, %.0f s", done, total, bench::secondsSince(start));
       }
@@ -279,14 +281,15 @@ int run(const BenchOptions& options) {
     Config config = best.config;
     config.subpixel = subpixel;
     for (const PreparedScene& scene : scenes) {
-      edge_runs.push_back(solve(scene, config, options.max_iterations));
+      edge_runs.push_back(solve(scene, config, options));
     }
   }
 
   writeCsv(runs, out / "runs.csv");
   writeSummary(sweep, edge_runs, named, out / "summary.md");
 
-  std::printf("# strategy_bench: %d runs on %zu scenes\n", total, scenes.size());
+  std::printf("# strategy_bench: %d runs on %zu scenes, %s\n", total, scenes.size(),
+              options.curve_blocks ? "a solver block per curve" : "a solver block per variable");
   double ate_before = 0.0;
   for (const Run& run : runs) ate_before += 1e3 * run.before.position_ate_sim3;
   bench::print("ate_before_mm_mean", ate_before / runs.size());
@@ -317,6 +320,9 @@ int main(int argc, char** argv) {
   app.add_flag("--quick", options.quick, "One scene and a ninth of the sweep (smoke test)");
   app.add_option("--max-iterations", options.max_iterations, "Ceres iterations per solve")
       ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  app.add_option("--curve-blocks", options.curve_blocks,
+                 "One solver block per curve (false: one per variable)")
       ->capture_default_str();
   return curvesfm::bench::parseAndRun(app, argc, argv, [&] { return curvesfm::run(options); });
 }

@@ -1,6 +1,8 @@
 #include "graph/ceres_manifolds.h"
 
 #include <Eigen/Core>
+#include <cmath>
+#include <stdexcept>
 
 #include "core/direction.h"
 #include "core/pose3.h"
@@ -77,10 +79,13 @@ const ceres::Manifold* manifoldFor(VariableType type) {
   static const PoseManifold pose_manifold;
   static const DirectionManifold direction_manifold;
   switch (type) {
-    case VariableType::kPose3: return &pose_manifold;
-    case VariableType::kDirection: return &direction_manifold;
+    case VariableType::kPose3:
+      return &pose_manifold;
+    case VariableType::kDirection:
+      return &direction_manifold;
     case VariableType::kPoint3:
-    case VariableType::kScalar: return nullptr;
+    case VariableType::kScalar:
+      return nullptr;
   }
   return nullptr;
 }
@@ -92,9 +97,8 @@ void liftToAmbient(VariableType type, const double* x, const double* tangent_jac
       Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>> Jt(
           tangent_jacobian, rows, 6);
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> Ja(ambient_jacobian,
-                                                                                rows, 7);
-      Ja.leftCols<4>().noalias() =
-          Jt.leftCols<3>() * (4.0 * quaternionPlusJacobian(x).transpose());
+                                                                               rows, 7);
+      Ja.leftCols<4>().noalias() = Jt.leftCols<3>() * (4.0 * quaternionPlusJacobian(x).transpose());
       Ja.rightCols<3>() = Jt.rightCols<3>();
       return;
     }
@@ -102,7 +106,7 @@ void liftToAmbient(VariableType type, const double* x, const double* tangent_jac
       Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>> Jt(
           tangent_jacobian, rows, 2);
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>> Ja(ambient_jacobian,
-                                                                                rows, 3);
+                                                                               rows, 3);
       Ja.noalias() = Jt * Direction::fromAmbient(x).basis().transpose();
       return;
     }
@@ -111,6 +115,67 @@ void liftToAmbient(VariableType type, const double* x, const double* tangent_jac
       std::copy(tangent_jacobian, tangent_jacobian + rows * tangentDim(type), ambient_jacobian);
       return;
   }
+}
+
+namespace {
+
+// C = B(x)^T * d(retract(anchor, delta))/d delta for x = retract(anchor, delta). With xi = B0
+// delta and theta = |xi|, retract = cos(theta) v0 + sinc(theta) xi, whose derivative in xi is
+// sinc I - sinc v0 xi^T + k xi xi^T, k = (theta cos(theta) - sin(theta)) / theta^3.
+Eigen::Matrix2d directionChartJacobian(const Direction& anchor, const Eigen::Vector2d& delta,
+                                       const Direction& x) {
+  const Matrix32d B0 = anchor.basis();
+  const Eigen::Vector3d xi = B0 * delta;
+  const double theta = xi.norm();
+  // Series below 0.01, where k's closed form loses digits to cancellation.
+  const double t2 = theta * theta;
+  double sinc = 1.0 - t2 / 6.0 + t2 * t2 / 120.0;
+  double k = -1.0 / 3.0 + t2 / 30.0 - t2 * t2 / 840.0;
+  if (theta >= 1e-2) {
+    sinc = std::sin(theta) / theta;
+    k = (theta * std::cos(theta) - std::sin(theta)) / (theta * theta * theta);
+  }
+  const Eigen::Matrix3d d_retract = sinc * Eigen::Matrix3d::Identity() -
+                                    sinc * anchor.vector() * xi.transpose() +
+                                    k * xi * xi.transpose();
+  return x.basis().transpose() * d_retract * B0;
+}
+
+}  // namespace
+
+bool hasAnchoredChart(VariableType type) { return type != VariableType::kPose3; }
+
+void retractAnchored(VariableType type, const double* anchor, const double* delta, double* x) {
+  switch (type) {
+    case VariableType::kDirection:
+      Direction::fromAmbient(anchor).retract(Eigen::Vector2d::Map(delta)).toAmbient(x);
+      return;
+    case VariableType::kPoint3:
+    case VariableType::kScalar:
+      for (int i = 0; i < ambientDim(type); ++i) x[i] = anchor[i] + delta[i];
+      return;
+    case VariableType::kPose3:
+      break;
+  }
+  throw std::logic_error("retractAnchored: poses have no anchored chart");
+}
+
+void writeAnchoredJacobian(VariableType type, const double* anchor, const double* delta,
+                           const double* tangent_jacobian, int rows, double* block_jacobian,
+                           int block_size, int column) {
+  const int n = tangentDim(type);
+  using Out = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>, 0,
+                         Eigen::OuterStride<>>;
+  Out out(block_jacobian + column, rows, n, Eigen::OuterStride<>(block_size));
+  Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Jt(
+      tangent_jacobian, rows, n);
+  if (type != VariableType::kDirection) {
+    out = Jt;
+    return;
+  }
+  const Direction start = Direction::fromAmbient(anchor);
+  const Eigen::Vector2d step = Eigen::Vector2d::Map(delta);
+  out.noalias() = Jt * directionChartJacobian(start, step, start.retract(step));
 }
 
 }  // namespace curvesfm

@@ -39,4 +39,21 @@ const ceres::Manifold* manifoldFor(VariableType type);
 void liftToAmbient(VariableType type, const double* x, const double* tangent_jacobian, int rows,
                    double* ambient_jacobian);
 
+/// Anchored charts, for variables that share one solver block (CeresProblem's curve blocks).
+/// Such a block holds no manifold: it holds the tangent offsets delta of its variables from
+/// anchors fixed for the whole solve, x = retract(anchor, delta), so Ceres adds steps to it as to
+/// a vector and never multiplies a wide block's Jacobian by a PlusJacobian. Points, directions
+/// and scalars only (poses keep their own block and PoseManifold).
+bool hasAnchoredChart(VariableType type);
+/// x = retract(anchor, delta), ambient in and out.
+void retractAnchored(VariableType type, const double* anchor, const double* delta, double* x);
+/// Turns the factor's tangent Jacobian J_t at x = retract(anchor, delta) (rows x n, row-major,
+/// n = tangentDim) into d error / d delta = J_t * C, C = d localCoordinates(x, retract(anchor,
+/// delta + e)) / de at e = 0, written into columns [column, column + n) of `block_jacobian`
+/// (rows x block_size, row-major). C is the identity but for directions, whose exponential map
+/// bends away from the anchor's tangent plane.
+void writeAnchoredJacobian(VariableType type, const double* anchor, const double* delta,
+                           const double* tangent_jacobian, int rows, double* block_jacobian,
+                           int block_size, int column);
+
 }  // namespace curvesfm

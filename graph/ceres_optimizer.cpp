@@ -8,6 +8,15 @@
 #include "graph/optimizer.h"
 
 namespace curvesfm {
+namespace {
+
+bool isSchur(LinearSolver solver) {
+  return solver == LinearSolver::kSparseSchur || solver == LinearSolver::kDenseSchur ||
+         solver == LinearSolver::kIterativeSchur;
+}
+
+}  // namespace
+
 OptimizationSummary optimize(const FactorGraph& graph, Values* values, const ProblemConfig& config,
                              const OptimizerOptions& options) {
   options.validate();
@@ -15,20 +24,28 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values, const Pro
   OptimizationSummary summary;
   summary.num_factors = static_cast<int>(graph.size());
 
-  CeresProblem bridge(graph, *values, config);
+  CeresProblem bridge(graph, *values, config, options);
   summary.initial_cost_by_type = bridge.costByType();
   ceres::Solver::Options ceres_options = toCeresOptions(options);
   summary.ordering = "automatic";
-  if (options.structure_first_ordering) {
+  if (isSchur(options.linear_solver) && !bridge.hasFreePose()) {
+    // With every pose held nothing is left for a Schur complement to reduce to: the normal
+    // equations are block diagonal per curve and point, and a sparse Cholesky of them gives
+    // the same step without the eliminator's per-block overhead.
+    ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    summary.ordering = "none (no free pose: sparse normal Cholesky)";
+  } else if (options.structure_first_ordering) {
     std::string why_not;
-    ceres_options.linear_solver_ordering = bridge.structureFirstOrdering(&why_not);
-    summary.ordering =
-        ceres_options.linear_solver_ordering ? "structure_first" : "automatic (" + why_not + ")";
+    std::string blocks;
+    ceres_options.linear_solver_ordering = bridge.structureFirstOrdering(&why_not, &blocks);
+    summary.ordering = ceres_options.linear_solver_ordering ? "structure_first (" + blocks + ")"
+                                                            : "automatic (" + why_not + ")";
   }
   if (options.use_inner_iterations) {
     ceres_options.inner_iteration_ordering = bridge.innerIterationOrdering();
   }
   summary.num_constant_variables = bridge.numConstant();
+  summary.num_curve_blocks = bridge.numCurveBlocks();
   summary.num_free_variables = static_cast<int>(bridge.keys().size()) - bridge.numConstant();
   summary.setup_seconds = secondsSince(start);
 

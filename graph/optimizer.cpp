@@ -11,9 +11,11 @@ void OptimizerOptions::validate() const {
   const OptionCheck require("OptimizerOptions");
   require(max_iterations >= 0, "max_iterations", max_iterations, "must be >= 0");
   require(num_threads >= 1, "num_threads", num_threads, "must be >= 1");
+  require.positive("initial_trust_region_radius", initial_trust_region_radius);
   require.positive("function_tolerance", function_tolerance);
   require.positive("gradient_tolerance", gradient_tolerance);
   require.positive("parameter_tolerance", parameter_tolerance);
+  require(max_curve_block_size >= 1, "max_curve_block_size", max_curve_block_size, "must be >= 1");
 }
 
 std::string OptimizationSummary::toString() const {

@@ -48,9 +48,15 @@ struct EnumNames<TrustRegion> {
 struct OptimizerOptions {
   /// Linear solver of each step. Schur solvers eliminate structure (points, curve variables)
   /// first; iterative_schur uses the SCHUR_JACOBI preconditioner; sparse ones use SuiteSparse.
+  /// A solve with every pose held (structure only) uses sparse_normal_cholesky whatever this
+  /// says: there is no reduced system, and the step is the same.
   LinearSolver linear_solver = LinearSolver::kSparseSchur;
   TrustRegion trust_region = TrustRegion::kLevenbergMarquardt;  ///< Step strategy.
   int max_iterations = 50;                                      ///< Outer iterations; >= 0.
+  /// The first step's trust region (Ceres' initial_trust_region_radius; Levenberg-Marquardt's
+  /// first damping is its inverse). Ceres' default 1e4 lets the first steps go nearly
+  /// undamped, and a solve far from its optimum rejects a handful of them first; > 0.
+  double initial_trust_region_radius = 1e4;
   int num_threads = 1;                ///< Threads for evaluation and linear algebra; >= 1.
   double function_tolerance = 1e-6;   ///< Stop when |dcost|/cost < this; > 0.
   double gradient_tolerance = 1e-10;  ///< Stop when max |gradient| < this; > 0.
@@ -58,6 +64,18 @@ struct OptimizerOptions {
   /// Schur elimination order: structure first, poses last. Falls back to Ceres' automatic
   /// ordering (and says so in the summary) when structure variables share a factor.
   bool structure_first_ordering = true;
+  /// One solver block per curve: its free Q, v and d together, held as offsets from their start
+  /// values (anchored charts, see retractAnchored), so that every curve factor touches one pose
+  /// block and one structure block and the Schur complement eliminates whole curves: the reduced
+  /// system holds the poses (and any structure still coupled). Same objective and optimum as a
+  /// block per variable, where Ceres can eliminate only an independent subset of the curve
+  /// variables and the rest stays in the reduced system. Only when some pose is free: with
+  /// every pose held the curves do not meet in a reduced system, and a block per variable keeps
+  /// each Jacobian as narrow as its segment.
+  bool curve_blocks = true;
+  /// A curve with more free tangent dimensions than this (7 per segment + 5) keeps a block per
+  /// variable: every observation fills a Jacobian as wide as its curve's block; >= 1.
+  int max_curve_block_size = 229;
   /// Ceres inner iterations (a non-linear refinement of each step per independent block set).
   bool use_inner_iterations = false;
   bool verbose = false;  ///< Print Ceres' per-iteration log to stdout.
@@ -77,7 +95,9 @@ struct OptimizationSummary {
   std::string termination;    ///< "CONVERGENCE", "NO_CONVERGENCE" (iteration limit), ...
   std::string message;        ///< Ceres' reason for terminating.
   std::string linear_solver;  ///< Linear solver Ceres actually used.
-  std::string ordering;       ///< "structure_first" or why Ceres chose ("automatic: ...").
+  /// "structure_first (E eliminated, R reduced blocks)" or why Ceres chose ("automatic (...)").
+  std::string ordering;
+  int num_curve_blocks = 0;  ///< Curves solved as one block each (OptimizerOptions::curve_blocks).
   int num_factors = 0;
   int num_free_variables = 0;
   int num_constant_variables = 0;

@@ -228,6 +228,9 @@ void addOptimizerOptions(OptionsTable* table, OptimizerOptions* o, const OptionP
                    place.describe("trust-region strategy"))
       .number("max_iterations", "max-iterations", &o->max_iterations,
               place.describe("most solver iterations per solve"))
+      .number("initial_trust_region_radius", "initial-trust-region",
+              &o->initial_trust_region_radius,
+              place.describe("first step's trust region (Levenberg-Marquardt: 1 / damping)"))
       .threads("num_threads", "threads", &o->num_threads, place.describe("solver threads"))
       .number("function_tolerance", "function-tolerance", &o->function_tolerance,
               place.describe("stop when the relative cost change falls below this"))
@@ -237,6 +240,12 @@ void addOptimizerOptions(OptionsTable* table, OptimizerOptions* o, const OptionP
               place.describe("stop when the relative step falls below this"))
       .boolean("structure_first_ordering", "structure-first", &o->structure_first_ordering,
                place.describe("Schur order structure first (false: Ceres chooses)"))
+      .boolean("curve_blocks", "curve-blocks", &o->curve_blocks,
+               place.describe("one solver block per curve, eliminated in the Schur complement "
+                              "(false: one per variable)"))
+      .number("max_curve_block_size", "max-curve-block", &o->max_curve_block_size,
+              place.describe("a curve with more free dimensions (7 per segment + 5) keeps a "
+                             "block per variable"))
       .boolean("use_inner_iterations", "inner-iterations", &o->use_inner_iterations,
                place.describe("Ceres inner iterations"))
       .boolean("verbose", "verbose", &o->verbose, place.describe("print Ceres' iteration log"));

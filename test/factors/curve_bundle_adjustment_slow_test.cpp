@@ -20,12 +20,13 @@ struct Solved {
 };
 
 Solved solve(const CurveScene& scene, Strategy strategy,
-             const CurveBundleAdjustmentOptions& ba = {}) {
+             const CurveBundleAdjustmentOptions& ba = {}, bool curve_blocks = true) {
   const CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
   CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
   SchedulerOptions scheduler;
   scheduler.strategy = strategy;
   scheduler.optimizer.max_iterations = 100;
+  scheduler.optimizer.curve_blocks = curve_blocks;
   Solved solved;
   solved.before = evaluateCurveScene(scene, input.cam_from_world, input.curves);
   solved.report = runSchedule(problem.graph, &problem.values, problem.config, scheduler);
@@ -49,6 +50,27 @@ TEST(CurveBundleAdjustment, JointRecoversPosesAndCurvesFromAPerturbedStart) {
   EXPECT_LT(solved.after.rotation_mean_deg, 0.1 * solved.before.rotation_mean_deg);
   EXPECT_LT(solved.after.curve_mean_error_aligned, 0.5 * solved.before.curve_mean_error_aligned);
   EXPECT_LT(solved.report.final_cost, 0.1 * solved.report.initial_cost);
+}
+
+TEST(CurveBundleAdjustment, ABlockPerCurveReachesTheOptimumOfABlockPerVariable) {
+  // A small start error, so that both steps sequences end in the same basin.
+  CurveSceneOptions options;
+  options.pose_noise_translation = 0.005;
+  options.pose_noise_rotation_deg = 0.2;
+  options.curve_point_noise = 0.005;
+  const CurveScene scene = makeCurveScene(options);
+  const Solved per_variable = solve(scene, Strategy::kJoint, {}, false);
+  const Solved per_curve = solve(scene, Strategy::kJoint, {}, true);
+  const OptimizationSummary& a = per_variable.report.rounds.front().summary;
+  const OptimizationSummary& b = per_curve.report.rounds.front().summary;
+  EXPECT_EQ(a.ordering.rfind("automatic", 0), 0u) << a.ordering;
+  EXPECT_EQ(b.ordering.rfind("structure_first", 0), 0u) << b.ordering;
+  EXPECT_EQ(b.num_curve_blocks, static_cast<int>(scene.true_curves.size()));
+  EXPECT_NEAR(b.initial_cost, a.initial_cost, 1e-9 * a.initial_cost);
+  EXPECT_NEAR(b.final_cost, a.final_cost, 0.01 * a.final_cost);
+  EXPECT_NEAR(per_curve.after.position_ate_sim3, per_variable.after.position_ate_sim3, 2e-4);
+  EXPECT_NEAR(per_curve.after.curve_mean_error_aligned, per_variable.after.curve_mean_error_aligned,
+              5e-4);
 }
 
 TEST(CurveBundleAdjustment, AlternatingReachesTheCostOfJointAndImprovesAsMuch) {

@@ -17,6 +17,7 @@ namespace curvesfm {
 namespace {
 
 using testing::AllTypesFactor;
+
 using testing::PointPriorFactor;
 
 Values randomValues(std::mt19937& rng) {
@@ -66,6 +67,39 @@ TEST(FactorCostFunction, WhitensResidualsBySigma) {
   Eigen::Vector3d residual;
   ASSERT_TRUE(cost.Evaluate(blocks.pointers.data(), residual.data(), nullptr));
   EXPECT_TRUE(residual.isApprox(factor->unwhitenedError(values) / 0.25));
+}
+
+// The factor over one curve's point, direction and length, as CeresProblem binds them when a
+// curve gets one block: the pose in a block of its own, the curve as offsets from anchors.
+TEST(FactorCostFunction, CurveBlockOffsetsFromAnchorsPassCeresGradientChecker) {
+  std::mt19937 rng(14);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const auto factor = std::make_shared<const AllTypesFactor>(
+      poseKey(0), curvePointKey(0, 0), directionKey(0, 0), startLengthKey(0, 0),
+      Eigen::Vector3d(0.5, -1.0, 2.0), NoiseModel{0.5, {}});
+  // Offsets from tiny (the series branch of the direction's chart) to about a radian.
+  for (double reach : {0.0, 1e-3, 0.05, 1.0}) {
+    const Values values = randomValues(rng);
+    std::vector<double> anchors(7);
+    values.toAmbient(pointKey(0), anchors.data());
+    values.toAmbient(directionKey(0, 0), anchors.data() + 3);
+    values.toAmbient(startLengthKey(0, 0), anchors.data() + 6);
+    const std::vector<VariableBinding> bindings = {{VariableType::kPose3, 0, nullptr, 0},
+                                                   {VariableType::kPoint3, 1, &anchors[0], 0},
+                                                   {VariableType::kDirection, 1, &anchors[3], 3},
+                                                   {VariableType::kScalar, 1, &anchors[6], 5}};
+    FactorCostFunction cost(factor, bindings, {7, 6});
+    const std::vector<const ceres::Manifold*> manifolds = {manifoldFor(VariableType::kPose3),
+                                                           nullptr};
+    ceres::NumericDiffOptions numeric_options;
+    ceres::GradientChecker checker(&cost, &manifolds, numeric_options);
+    testing::AmbientBlocks blocks(*allTypesFactor(), values);
+    blocks.storage.resize(2);
+    blocks.storage[1].resize(6);
+    for (double& offset : blocks.storage[1]) offset = reach * n(rng);
+    blocks.pointers = {blocks.storage[0].data(), blocks.storage[1].data()};
+    testing::expectProbeAgrees(checker, blocks, 1e-7);
+  }
 }
 
 // Pose, point, direction and scale pinned by enough factors to have a unique optimum.
@@ -175,26 +209,144 @@ TEST(Optimize, EverySolverChoiceConverges) {
       OptimizerOptions options;
       options.linear_solver = solver;
       options.trust_region = region;
-      const OptimizationSummary summary = optimize(toy.graph, &values, posesConstant(), options);
+      ProblemConfig config;
+      config.setConstant(poseKey(0));
+      const OptimizationSummary summary = optimize(toy.graph, &values, config, options);
       EXPECT_LT(summary.final_cost, 1e-8) << toString(solver) << " " << toString(region);
     }
   }
 }
 
-TEST(Optimize, FallsBackToAutomaticOrderingWhenStructureIsCoupled) {
+TEST(Optimize, WithEveryPoseHeldSchurSolversGiveWayToSparseCholesky) {
   ToyProblem toy = makeToyProblem();
   Values values = toy.start;
   const OptimizationSummary summary =
       optimize(toy.graph, &values, posesConstant(), OptimizerOptions());
-  // AllTypesFactor ties the point, direction and scale together: not an independent set.
-  EXPECT_EQ(summary.ordering.rfind("automatic (factor couples", 0), 0u) << summary.ordering;
+  EXPECT_EQ(summary.linear_solver, "SPARSE_NORMAL_CHOLESKY");
+  EXPECT_EQ(summary.ordering, "none (no free pose: sparse normal Cholesky)");
+}
+
+TEST(Optimize, FallsBackToAutomaticOrderingWhenStructureIsCoupled) {
+  ToyProblem toy = makeToyProblem();
+  Values values = toy.start;
+  ProblemConfig config;
+  config.setConstant(poseKey(0));
+  const OptimizationSummary summary = optimize(toy.graph, &values, config, OptimizerOptions());
+  // AllTypesFactor ties the point to the curve block of the direction and scale.
+  EXPECT_EQ(summary.ordering, "automatic (factor all_types couples two structure blocks)");
+}
+
+// The toy problem with its point a curve point: point, direction and length are one curve.
+ToyProblem makeToyCurve() {
+  ToyProblem toy = makeToyProblem();
+  FactorGraph graph;
+  for (const auto& factor : toy.graph) {
+    const auto* all_types = dynamic_cast<const AllTypesFactor*>(factor.get());
+    if (!all_types) continue;
+    graph.add(std::make_shared<AllTypesFactor>(factor->keys()[0], curvePointKey(0, 0),
+                                               directionKey(0, 0), startLengthKey(0, 0),
+                                               all_types->target()));
+  }
+  for (Values* values : {&toy.truth, &toy.start}) {
+    values->insert(curvePointKey(0, 0), values->at<Eigen::Vector3d>(pointKey(0)));
+    values->erase(pointKey(0));
+  }
+  graph.emplace<PointPriorFactor>(curvePointKey(0, 0),
+                                  toy.truth.at<Eigen::Vector3d>(curvePointKey(0, 0)));
+  toy.graph = graph;
+  return toy;
+}
+
+OptimizerOptions tightOptions(bool curve_blocks) {
+  OptimizerOptions options;
+  options.function_tolerance = 1e-14;
+  options.gradient_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-14;
+  options.curve_blocks = curve_blocks;
+  return options;
+}
+
+TEST(Optimize, ACurveBlockIsEliminatedAndReachesTheSameOptimum) {
+  const ToyProblem toy = makeToyCurve();
+  ProblemConfig config;
+  config.setConstant(poseKey(0));
+  Values per_variable = toy.start;
+  const OptimizationSummary a = optimize(toy.graph, &per_variable, config, tightOptions(false));
+  Values per_curve = toy.start;
+  const OptimizationSummary b = optimize(toy.graph, &per_curve, config, tightOptions(true));
+  EXPECT_EQ(a.ordering, "automatic (factor all_types couples two structure blocks)");
+  EXPECT_EQ(b.ordering, "structure_first (1 eliminated, 4 reduced blocks)");
+  EXPECT_EQ(b.num_curve_blocks, 1);
+  EXPECT_EQ(b.num_free_variables, a.num_free_variables);
+  EXPECT_EQ(b.num_effective_parameters, a.num_effective_parameters);
+  EXPECT_NEAR(b.initial_cost, a.initial_cost, 1e-12 * a.initial_cost);
+  EXPECT_LT(a.final_cost, 1e-16);
+  EXPECT_LT(b.final_cost, 1e-16);
+  for (int i = 1; i < 5; ++i) {
+    const Pose3& x = per_variable.at<Pose3>(poseKey(i));
+    const Pose3& y = per_curve.at<Pose3>(poseKey(i));
+    EXPECT_LT(x.localCoordinates(y).norm(), 1e-8) << "pose " << i;
+  }
+  EXPECT_LT((per_variable.at<Eigen::Vector3d>(curvePointKey(0, 0)) -
+             per_curve.at<Eigen::Vector3d>(curvePointKey(0, 0)))
+                .norm(),
+            1e-8);
+  EXPECT_LT(per_variable.at<Direction>(directionKey(0, 0))
+                .angleTo(per_curve.at<Direction>(directionKey(0, 0))),
+            1e-8);
+  EXPECT_NEAR(per_variable.at<double>(startLengthKey(0, 0)),
+              per_curve.at<double>(startLengthKey(0, 0)), 1e-8);
+}
+
+TEST(CeresProblem, ACurvesConstantVariablesWaitAtTheirStartBesideItsFreeOnes) {
+  const ToyProblem toy = makeToyCurve();
+  ProblemConfig config;
+  config.setConstant(poseKey(0));
+  config.setConstant(startLengthKey(0, 0));
+  Values values = toy.start;
+  values.update(startLengthKey(0, 0), toy.truth.at<double>(startLengthKey(0, 0)));
+  const OptimizationSummary summary = optimize(toy.graph, &values, config, tightOptions(true));
+  EXPECT_EQ(summary.num_curve_blocks, 1);
+  // Ceres counts constant blocks too: the five poses' 30 and the curve block's 5, without the
+  // length, which waits at its anchor outside every block.
+  EXPECT_EQ(summary.num_effective_parameters, 35);
+  EXPECT_EQ(values.at<double>(startLengthKey(0, 0)), toy.truth.at<double>(startLengthKey(0, 0)));
+  EXPECT_LT((values.at<Eigen::Vector3d>(curvePointKey(0, 0)) -
+             toy.truth.at<Eigen::Vector3d>(curvePointKey(0, 0)))
+                .norm(),
+            1e-8);
+  EXPECT_LT(
+      values.at<Direction>(directionKey(0, 0)).angleTo(toy.truth.at<Direction>(directionKey(0, 0))),
+      1e-8);
+}
+
+TEST(CeresProblem, WithEveryPoseHeldCurvesKeepABlockPerVariable) {
+  const ToyProblem toy = makeToyCurve();
+  CeresProblem bridge(toy.graph, toy.start, posesConstant(), OptimizerOptions());
+  EXPECT_EQ(bridge.numCurveBlocks(), 0);
+  EXPECT_NE(bridge.block(curvePointKey(0, 0)), bridge.block(directionKey(0, 0)));
+}
+
+TEST(CeresProblem, ACurveWiderThanTheLimitKeepsABlockPerVariable) {
+  const ToyProblem toy = makeToyCurve();
+  OptimizerOptions options;
+  options.max_curve_block_size = 5;  // the curve has 3 + 2 + 1 free dimensions
+  CeresProblem narrow(toy.graph, toy.start, ProblemConfig(), options);
+  EXPECT_EQ(narrow.numCurveBlocks(), 0);
+  EXPECT_NE(narrow.block(curvePointKey(0, 0)), narrow.block(directionKey(0, 0)));
+  options.max_curve_block_size = 6;
+  CeresProblem wide(toy.graph, toy.start, ProblemConfig(), options);
+  EXPECT_EQ(wide.numCurveBlocks(), 1);
+  EXPECT_EQ(wide.block(curvePointKey(0, 0)), wide.block(directionKey(0, 0)));
 }
 
 TEST(CeresProblem, InnerIterationOrderingHoldsEveryFreeBlockInIndependentSets) {
   ToyProblem toy = makeToyProblem();
   ProblemConfig config;
   config.setConstant(poseKey(0));
-  CeresProblem bridge(toy.graph, toy.start, config);
+  OptimizerOptions per_variable;
+  per_variable.curve_blocks = false;
+  CeresProblem bridge(toy.graph, toy.start, config, per_variable);
   const auto ordering = bridge.innerIterationOrdering();
   // Free: poses 1..4, the point, the direction and the length; pose 0 is constant.
   EXPECT_EQ(ordering->NumElements(), 7);

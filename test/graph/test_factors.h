@@ -8,8 +8,7 @@
 
 namespace curvesfm::testing {
 
-class AllTypesFactor
-    : public NoiseModelFactorN<3, Pose3, Eigen::Vector3d, Direction, double> {
+class AllTypesFactor : public NoiseModelFactorN<3, Pose3, Eigen::Vector3d, Direction, double> {
   using Base = NoiseModelFactorN<3, Pose3, Eigen::Vector3d, Direction, double>;
 
  public:
@@ -33,6 +32,7 @@ class AllTypesFactor
     return R * local + pose.translation() - target_;
   }
   const char* typeName() const override { return "all_types"; }
+  const Eigen::Vector3d& target() const { return target_; }
 
  private:
   Eigen::Vector3d target_;
@@ -45,8 +45,7 @@ class PointPriorFactor : public NoiseModelFactorN<3, Eigen::Vector3d> {
  public:
   PointPriorFactor(Key point, const Eigen::Vector3d& target, NoiseModel noise = {})
       : Base({point}, noise), target_(target) {}
-  Error evaluateError(const Eigen::Vector3d& point,
-                      Jacobian<Eigen::Vector3d>* H) const override {
+  Error evaluateError(const Eigen::Vector3d& point, Jacobian<Eigen::Vector3d>* H) const override {
     if (H) H->setIdentity();
     return point - target_;
   }

@@ -53,13 +53,15 @@ void CeresProblem::layOut(const std::vector<Key>& used,
                           const std::unordered_map<Key, VariableType>& types,
                           const OptimizerOptions& options) {
   // With every pose held, no reduced system couples the curves: each is solved alone either
-  // way, and a block per variable keeps its Jacobians as narrow as its segments.
+  // way, and a block per variable keeps its Jacobians as narrow as its segments. Inner
+  // iterations refine each block alone, and whole curves did worse there than their variables
+  // (strategy bench, docs/benchmarks.md).
   const bool any_free_pose = std::any_of(used.begin(), used.end(), [this](Key key) {
     return categoryOf(key) == VariableCategory::kPose && !config_.isConstant(key);
   });
   // Free tangent dimensions per curve: a curve with any, and not too many, gets one block.
   std::unordered_map<std::uint64_t, int> curve_size;
-  if (options.curve_blocks && any_free_pose) {
+  if (options.curve_blocks && any_free_pose && !options.use_inner_iterations) {
     for (Key key : used) {
       if (isCurveVariable(key) && !config_.isConstant(key)) {
         curve_size[key.index()] += tangentDim(types.at(key));

@@ -69,9 +69,10 @@ struct OptimizerOptions {
   /// block and one structure block and the Schur complement eliminates whole curves: the reduced
   /// system holds the poses (and any structure still coupled). Same objective and optimum as a
   /// block per variable, where Ceres can eliminate only an independent subset of the curve
-  /// variables and the rest stays in the reduced system. Only when some pose is free: with
+  /// variables and the rest stays in the reduced system. Only when some pose is free (with
   /// every pose held the curves do not meet in a reduced system, and a block per variable keeps
-  /// each Jacobian as narrow as its segment.
+  /// each Jacobian as narrow as its segment) and without inner iterations (which refine each
+  /// block alone; on whole curves they did worse on the strategy bench).
   bool curve_blocks = true;
   /// A curve with more free tangent dimensions than this (7 per segment + 5) keeps a block per
   /// variable: every observation fills a Jacobian as wide as its curve's block; >= 1.

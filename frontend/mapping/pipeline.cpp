@@ -268,6 +268,14 @@ struct Pipeline::Impl {
   cv::Mat prepareKeyframe(const PipelineFrame& frame, std::vector<EdgeChain>* chains,
                           KeyframeStats* stats);
   void trackPose(Keyframe* keyframe);
+  /// One attempt to register segment i of curve `id` in keyframe k (see tryRegister).
+  struct SegmentAttempt {
+    bool explained_elsewhere = false;  ///< Skipped: most of it lies on already explained edges.
+    CorrespondenceVerdict verdict;
+    std::vector<cv::Point> polyline;  ///< Its projection into keyframe k.
+  };
+  SegmentAttempt tryRegister(int k, const KeyframeView& view, int id, int i,
+                             const CorrespondenceOptions& checks, const cv::Mat* explained);
   void registerTier(int k, CurveState state, bool skip_explained, cv::Mat* explained,
                     KeyframeStats* stats);
   void registerMap(int k, cv::Mat* explained, KeyframeStats* stats);
@@ -398,33 +406,45 @@ void Pipeline::Impl::trackPose(Keyframe* keyframe) {
   if (summary.usable) keyframe->cam_from_world = extractPoses(problem.values, 1)[0];
 }
 
+// Projects segment i of curve `id` into keyframe k and, unless more than half of it lies on
+// `explained` (when given: edges another curve explains, which it must not take over), runs the
+// correspondence checks and adds the observation they accept.
+Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const KeyframeView& view, int id,
+                                                           int i,
+                                                           const CorrespondenceOptions& checks,
+                                                           const cv::Mat* explained) {
+  const int samples = 2 * options.correspondence.samples_per_segment + 1;
+  const MapCurve& curve = map.curve(id);
+  const BezierSegmentParams segment = curve.curve.segment(i);
+  SegmentAttempt attempt;
+  attempt.polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera, samples);
+  if (explained && fractionOnMask(attempt.polyline, *explained) > 0.5) {
+    attempt.explained_elsewhere = true;
+    return attempt;
+  }
+  attempt.verdict = registerSegment(segment, view, curve.segments[i].history(), checks);
+  if (attempt.verdict.registered)
+    map.addObservation(id, i, registration(id, i, k, attempt.verdict));
+  return attempt;
+}
+
 void Pipeline::Impl::registerTier(int k, CurveState state, bool skip_explained, cv::Mat* explained,
                                   KeyframeStats* stats) {
-  const Keyframe& keyframe = keyframes[k];
-  const KeyframeView view = viewOf(keyframe, *camera);
-  const int samples = 2 * options.correspondence.samples_per_segment + 1;
+  const KeyframeView view = viewOf(keyframes[k], *camera);
   const int thickness = 2 * static_cast<int>(std::ceil(options.explained_radius_px)) + 1;
   std::vector<std::vector<cv::Point>> registered;
   for (const int id : map.curvesIn(state)) {
-    const MapCurve& curve = map.curve(id);
-    for (int i = 0; i < curve.curve.numSegments(); ++i) {
-      const BezierSegmentParams segment = curve.curve.segment(i);
-      std::vector<cv::Point> polyline =
-          projectSegment(segment, keyframe.cam_from_world, *camera, samples);
-      // A lower tier must not take over edges a higher one explains: duplicates of a curve.
-      if (skip_explained && fractionOnMask(polyline, *explained) > 0.5) {
+    for (int i = 0; i < map.curve(id).curve.numSegments(); ++i) {
+      SegmentAttempt attempt =
+          tryRegister(k, view, id, i, options.correspondence, skip_explained ? explained : nullptr);
+      if (attempt.explained_elsewhere) {
         ++stats->rejected_duplicate;
-        continue;
+      } else if (!attempt.verdict.registered) {
+        countRejection(attempt.verdict.failed_check, stats);
+      } else {
+        ++stats->registered_segments;
+        if (!attempt.polyline.empty()) registered.push_back(std::move(attempt.polyline));
       }
-      const CorrespondenceVerdict verdict =
-          registerSegment(segment, view, curve.segments[i].history(), options.correspondence);
-      if (!verdict.registered) {
-        countRejection(verdict.failed_check, stats);
-        continue;
-      }
-      map.addObservation(id, i, registration(id, i, k, verdict));
-      ++stats->registered_segments;
-      if (!polyline.empty()) registered.push_back(std::move(polyline));
     }
   }
   cv::polylines(*explained, registered, false, cv::Scalar(255), thickness);
@@ -470,21 +490,13 @@ int Pipeline::Impl::reassociateIn(int k, const std::vector<int>& ids,
   if (options.reassociation_skip_explained) explained = explainedEdges(k, samples, thickness);
   int added = 0;
   for (const int id : ids) {
-    const MapCurve& curve = map.curve(id);
-    for (int i = 0; i < curve.curve.numSegments(); ++i) {
-      if (curve.segments[i].observedIn(k)) continue;
-      const BezierSegmentParams segment = curve.curve.segment(i);
-      std::vector<cv::Point> polyline;
-      if (!explained.empty()) {
-        polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera, samples);
-        if (fractionOnMask(polyline, explained) > 0.5) continue;
-      }
-      const CorrespondenceVerdict verdict =
-          registerSegment(segment, view, curve.segments[i].history(), checks);
-      if (!verdict.registered) continue;
-      map.addObservation(id, i, registration(id, i, k, verdict));
-      if (!polyline.empty()) {
-        cv::polylines(explained, std::vector<std::vector<cv::Point>>{polyline}, false,
+    for (int i = 0; i < map.curve(id).curve.numSegments(); ++i) {
+      if (map.curve(id).segments[i].observedIn(k)) continue;
+      const SegmentAttempt attempt =
+          tryRegister(k, view, id, i, checks, explained.empty() ? nullptr : &explained);
+      if (!attempt.verdict.registered) continue;
+      if (!explained.empty() && !attempt.polyline.empty()) {
+        cv::polylines(explained, std::vector<std::vector<cv::Point>>{attempt.polyline}, false,
                       cv::Scalar(255), thickness);
       }
       ++added;

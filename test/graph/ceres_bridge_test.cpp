@@ -327,6 +327,14 @@ TEST(CeresProblem, WithEveryPoseHeldCurvesKeepABlockPerVariable) {
   EXPECT_NE(bridge.block(curvePointKey(0, 0)), bridge.block(directionKey(0, 0)));
 }
 
+TEST(CeresProblem, WithInnerIterationsCurvesKeepABlockPerVariable) {
+  const ToyProblem toy = makeToyCurve();
+  OptimizerOptions options;
+  options.use_inner_iterations = true;
+  CeresProblem bridge(toy.graph, toy.start, ProblemConfig(), options);
+  EXPECT_EQ(bridge.numCurveBlocks(), 0);
+}
+
 TEST(CeresProblem, ACurveWiderThanTheLimitKeepsABlockPerVariable) {
   const ToyProblem toy = makeToyCurve();
   OptimizerOptions options;

@@ -62,7 +62,8 @@ struct OptimizerOptions {
   double gradient_tolerance = 1e-10;  ///< Stop when max |gradient| < this; > 0.
   double parameter_tolerance = 1e-8;  ///< Stop when |dx| / (|x| + tol) < this; > 0.
   /// Schur elimination order: structure first, poses last. Falls back to Ceres' automatic
-  /// ordering (and says so in the summary) when structure variables share a factor.
+  /// ordering (and says so in the summary) when most structure blocks share a factor with
+  /// another one (a block per curve variable).
   bool structure_first_ordering = true;
   /// One solver block per curve: its free Q, v and d together, held as offsets from their start
   /// values (anchored charts, see retractAnchored), so that every curve factor touches one pose
@@ -96,7 +97,8 @@ struct OptimizationSummary {
   std::string termination;    ///< "CONVERGENCE", "NO_CONVERGENCE" (iteration limit), ...
   std::string message;        ///< Ceres' reason for terminating.
   std::string linear_solver;  ///< Linear solver Ceres actually used.
-  /// "structure_first (E eliminated, R reduced blocks)" or why Ceres chose ("automatic (...)").
+  /// "structure_first (E eliminated, R reduced blocks)", why Ceres chose ("automatic (...)"),
+  /// or "none (...)" when no pose is free.
   std::string ordering;
   int num_curve_blocks = 0;  ///< Curves solved as one block each (OptimizerOptions::curve_blocks).
   int num_factors = 0;

@@ -58,6 +58,7 @@ nlohmann::json summaryToJson(const OptimizationSummary& summary) {
       {"num_factors", summary.num_factors},
       {"num_free_variables", summary.num_free_variables},
       {"num_constant_variables", summary.num_constant_variables},
+      {"num_curve_blocks", summary.num_curve_blocks},
       {"num_residuals", summary.num_residuals},
       {"num_effective_parameters", summary.num_effective_parameters},
       {"seconds",

@@ -2,8 +2,8 @@
 
 #include <Eigen/Core>
 #include <cmath>
-#include <stdexcept>
 
+#include "core/check.h"
 #include "core/direction.h"
 #include "core/pose3.h"
 #include "core/so3.h"
@@ -143,8 +143,6 @@ Eigen::Matrix2d directionChartJacobian(const Direction& anchor, const Eigen::Vec
 
 }  // namespace
 
-bool hasAnchoredChart(VariableType type) { return type != VariableType::kPose3; }
-
 void retractAnchored(VariableType type, const double* anchor, const double* delta, double* x) {
   switch (type) {
     case VariableType::kDirection:
@@ -157,7 +155,7 @@ void retractAnchored(VariableType type, const double* anchor, const double* delt
     case VariableType::kPose3:
       break;
   }
-  throw std::logic_error("retractAnchored: poses have no anchored chart");
+  CURVESFM_CHECK(false) << "retractAnchored: poses have no anchored chart";
 }
 
 void writeAnchoredJacobian(VariableType type, const double* anchor, const double* delta,

@@ -44,8 +44,8 @@ void liftToAmbient(VariableType type, const double* x, const double* tangent_jac
 /// anchors fixed for the whole solve, x = retract(anchor, delta), so Ceres adds steps to it as to
 /// a vector and never multiplies a wide block's Jacobian by a PlusJacobian. Points, directions
 /// and scalars only (poses keep their own block and PoseManifold).
-bool hasAnchoredChart(VariableType type);
-/// x = retract(anchor, delta), ambient in and out.
+
+/// x = retract(anchor, delta), ambient in and out. Throws CheckError for a pose.
 void retractAnchored(VariableType type, const double* anchor, const double* delta, double* x);
 /// Turns the factor's tangent Jacobian J_t at x = retract(anchor, delta) (rows x n, row-major,
 /// n = tangentDim) into d error / d delta = J_t * C, C = d localCoordinates(x, retract(anchor,

@@ -112,9 +112,10 @@ bool FactorCostFunction::Evaluate(double const* const* parameters, double* resid
       liftToAmbient(binding.type, parameters[binding.block], tangent[i], rows,
                     jacobians[binding.block]);
     } else {
-      writeAnchoredJacobian(
-          binding.type, binding.anchor, parameters[binding.block] + binding.column, tangent[i],
-          rows, jacobians[binding.block], parameter_block_sizes()[binding.block], binding.column);
+      writeAnchoredJacobian(binding.type, binding.anchor,
+                            parameters[binding.block] + binding.column, ambient[i], tangent[i],
+                            rows, jacobians[binding.block], parameter_block_sizes()[binding.block],
+                            binding.column);
     }
   }
   return true;

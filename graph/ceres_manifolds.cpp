@@ -159,8 +159,8 @@ void retractAnchored(VariableType type, const double* anchor, const double* delt
 }
 
 void writeAnchoredJacobian(VariableType type, const double* anchor, const double* delta,
-                           const double* tangent_jacobian, int rows, double* block_jacobian,
-                           int block_size, int column) {
+                           const double* x, const double* tangent_jacobian, int rows,
+                           double* block_jacobian, int block_size, int column) {
   const int n = tangentDim(type);
   using Out = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>, 0,
                          Eigen::OuterStride<>>;
@@ -171,9 +171,9 @@ void writeAnchoredJacobian(VariableType type, const double* anchor, const double
     out = Jt;
     return;
   }
-  const Direction start = Direction::fromAmbient(anchor);
-  const Eigen::Vector2d step = Eigen::Vector2d::Map(delta);
-  out.noalias() = Jt * directionChartJacobian(start, step, start.retract(step));
+  out.noalias() =
+      Jt * directionChartJacobian(Direction::fromAmbient(anchor), Eigen::Vector2d::Map(delta),
+                                  Direction::fromAmbient(x));
 }
 
 }  // namespace curvesfm

@@ -47,13 +47,13 @@ void liftToAmbient(VariableType type, const double* x, const double* tangent_jac
 
 /// x = retract(anchor, delta), ambient in and out. Throws CheckError for a pose.
 void retractAnchored(VariableType type, const double* anchor, const double* delta, double* x);
-/// Turns the factor's tangent Jacobian J_t at x = retract(anchor, delta) (rows x n, row-major,
-/// n = tangentDim) into d error / d delta = J_t * C, C = d localCoordinates(x, retract(anchor,
-/// delta + e)) / de at e = 0, written into columns [column, column + n) of `block_jacobian`
-/// (rows x block_size, row-major). C is the identity but for directions, whose exponential map
-/// bends away from the anchor's tangent plane.
+/// Turns the factor's tangent Jacobian J_t at x = retract(anchor, delta) (ambient, as
+/// retractAnchored gave it; rows x n, row-major, n = tangentDim) into d error / d delta = J_t * C,
+/// C = d localCoordinates(x, retract(anchor, delta + e)) / de at e = 0, written into columns
+/// [column, column + n) of `block_jacobian` (rows x block_size, row-major). C is the identity but
+/// for directions, whose exponential map bends away from the anchor's tangent plane.
 void writeAnchoredJacobian(VariableType type, const double* anchor, const double* delta,
-                           const double* tangent_jacobian, int rows, double* block_jacobian,
-                           int block_size, int column);
+                           const double* x, const double* tangent_jacobian, int rows,
+                           double* block_jacobian, int block_size, int column);
 
 }  // namespace curvesfm

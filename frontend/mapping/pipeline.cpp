@@ -281,7 +281,13 @@ struct Pipeline::Impl {
   void registerMap(int k, cv::Mat* explained, KeyframeStats* stats);
   int reassociate();
   int reassociateIn(int k, const std::vector<int>& ids, const CorrespondenceOptions& checks);
-  cv::Mat explainedEdges(int k, int samples, int thickness) const;
+  cv::Mat explainedEdges(int k) const;
+  /// Samples along a segment's projection when it is matched against explained edges.
+  int projectionSamples() const { return 2 * options.correspondence.samples_per_segment + 1; }
+  /// Width (px) of the band a registered segment explains around its projection.
+  int explainedThickness() const {
+    return 2 * static_cast<int>(std::ceil(options.explained_radius_px)) + 1;
+  }
   std::vector<int> depthReferences(int k, const std::vector<EdgeChain>& chains) const;
   EpipolarDepthOptions depthOptions(int k) const;
   PoseStage poseStage(const std::string& name) const;
@@ -413,11 +419,11 @@ Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const Keyframe
                                                            int i,
                                                            const CorrespondenceOptions& checks,
                                                            const cv::Mat* explained) {
-  const int samples = 2 * options.correspondence.samples_per_segment + 1;
   const MapCurve& curve = map.curve(id);
   const BezierSegmentParams segment = curve.curve.segment(i);
   SegmentAttempt attempt;
-  attempt.polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera, samples);
+  attempt.polyline =
+      projectSegment(segment, keyframes[k].cam_from_world, *camera, projectionSamples());
   if (explained && fractionOnMask(attempt.polyline, *explained) > 0.5) {
     attempt.explained_elsewhere = true;
     return attempt;
@@ -431,7 +437,6 @@ Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const Keyframe
 void Pipeline::Impl::registerTier(int k, CurveState state, bool skip_explained, cv::Mat* explained,
                                   KeyframeStats* stats) {
   const KeyframeView view = viewOf(keyframes[k], *camera);
-  const int thickness = 2 * static_cast<int>(std::ceil(options.explained_radius_px)) + 1;
   std::vector<std::vector<cv::Point>> registered;
   for (const int id : map.curvesIn(state)) {
     for (int i = 0; i < map.curve(id).curve.numSegments(); ++i) {
@@ -447,7 +452,7 @@ void Pipeline::Impl::registerTier(int k, CurveState state, bool skip_explained, 
       }
     }
   }
-  cv::polylines(*explained, registered, false, cv::Scalar(255), thickness);
+  cv::polylines(*explained, registered, false, cv::Scalar(255), explainedThickness());
 }
 
 void Pipeline::Impl::registerMap(int k, cv::Mat* explained, KeyframeStats* stats) {
@@ -483,11 +488,9 @@ int Pipeline::Impl::reassociate() {
 // Re-association in keyframe k of the segments of curves `ids` it does not observe yet.
 int Pipeline::Impl::reassociateIn(int k, const std::vector<int>& ids,
                                   const CorrespondenceOptions& checks) {
-  const int samples = 2 * options.correspondence.samples_per_segment + 1;
-  const int thickness = 2 * static_cast<int>(std::ceil(options.explained_radius_px)) + 1;
   const KeyframeView view = viewOf(keyframes[k], *camera);
   cv::Mat explained;
-  if (options.reassociation_skip_explained) explained = explainedEdges(k, samples, thickness);
+  if (options.reassociation_skip_explained) explained = explainedEdges(k);
   int added = 0;
   for (const int id : ids) {
     for (int i = 0; i < map.curve(id).curve.numSegments(); ++i) {
@@ -497,7 +500,7 @@ int Pipeline::Impl::reassociateIn(int k, const std::vector<int>& ids,
       if (!attempt.verdict.registered) continue;
       if (!explained.empty() && !attempt.polyline.empty()) {
         cv::polylines(explained, std::vector<std::vector<cv::Point>>{attempt.polyline}, false,
-                      cv::Scalar(255), thickness);
+                      cv::Scalar(255), explainedThickness());
       }
       ++added;
     }
@@ -506,9 +509,9 @@ int Pipeline::Impl::reassociateIn(int k, const std::vector<int>& ids,
 }
 
 // The pixels of keyframe k that the segments observed there explain: their projections at the
-// current poses and curves, drawn `thickness` px wide. Curves the sanity checks dropped explain
-// nothing.
-cv::Mat Pipeline::Impl::explainedEdges(int k, int samples, int thickness) const {
+// current poses and curves, drawn explainedThickness() px wide. Curves the sanity checks dropped
+// explain nothing.
+cv::Mat Pipeline::Impl::explainedEdges(int k) const {
   cv::Mat explained = cv::Mat::zeros(camera->height(), camera->width(), CV_8UC1);
   std::vector<std::vector<cv::Point>> polylines;
   for (int id = 0; id < map.size(); ++id) {
@@ -516,12 +519,12 @@ cv::Mat Pipeline::Impl::explainedEdges(int k, int samples, int thickness) const 
     if (curve.state == CurveState::kImplausible) continue;
     for (int i = 0; i < curve.curve.numSegments(); ++i) {
       if (!curve.segments[i].observedIn(k)) continue;
-      std::vector<cv::Point> polyline =
-          projectSegment(curve.curve.segment(i), keyframes[k].cam_from_world, *camera, samples);
+      std::vector<cv::Point> polyline = projectSegment(
+          curve.curve.segment(i), keyframes[k].cam_from_world, *camera, projectionSamples());
       if (!polyline.empty()) polylines.push_back(std::move(polyline));
     }
   }
-  cv::polylines(explained, polylines, false, cv::Scalar(255), thickness);
+  cv::polylines(explained, polylines, false, cv::Scalar(255), explainedThickness());
   return explained;
 }
 

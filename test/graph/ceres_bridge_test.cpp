@@ -398,6 +398,21 @@ TEST(OptimizerOptions, ValidateNamesFieldAndValue) {
   options = OptimizerOptions();
   options.function_tolerance = -1;
   EXPECT_THROW(options.validate(), InvalidOptions);
+  const auto expectRefused = [](const OptimizerOptions& bad, const std::string& field) {
+    try {
+      bad.validate();
+      ADD_FAILURE() << field << " accepted";
+    } catch (const InvalidOptions& e) {
+      EXPECT_NE(std::string(e.what()).find("OptimizerOptions." + field), std::string::npos)
+          << e.what();
+    }
+  };
+  options = OptimizerOptions();
+  options.max_curve_block_size = 0;
+  expectRefused(options, "max_curve_block_size = 0");
+  options = OptimizerOptions();
+  options.initial_trust_region_radius = 0.0;
+  expectRefused(options, "initial_trust_region_radius = 0");
   EXPECT_EQ(parseEnumName<LinearSolver>("iterative_schur", "OptimizerOptions", "x"),
             LinearSolver::kIterativeSchur);
   EXPECT_THROW(parseEnumName<LinearSolver>("cholesky", "OptimizerOptions", "linear_solver"),

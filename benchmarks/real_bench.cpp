@@ -17,13 +17,15 @@
 // --noise-rotation-deg, both per axis, Gaussian) and colmap (COLMAP's poses, which runs COLMAP
 // first). Each such row also holds the start's own ATE at the same keyframes (the run's
 // report.json) and refined / start; the summary prints them per set and start, with the spread
-// over the noise seeds, beside issue 14's targets. A set with ground-truth curves (Pavilion) also
-// gets `curvesfm eval-map` on every curve run: precision and recall of the curve map at 2 cm.
-// curvesfm runs as a subprocess (--curvesfm, default the one built beside this bench); a variant
-// whose flags the executable does not list in its --help is skipped with a note, so the table
-// can name flags that a later curvesfm adds. Every trajectory (init: every registered frame;
-// curves and hybrid: the keyframes; COLMAP: every registered image) is compared with the set's
-// ground truth from loadImageSequence by compareTrajectories (Sim(3),
+// over the noise seeds, beside issue 14's targets. --map-at truth|noise<seed> (truth and noise
+// starts only) makes every such run lift and register its curves at that start's poses
+// (`run --diagnose-frontend-poses`), so a map and a start of different errors meet. A set with
+// ground-truth curves (Pavilion) also gets `curvesfm eval-map` on every curve run: precision and
+// recall of the curve map at 2 cm. curvesfm runs as a subprocess (--curvesfm, default the one built
+// beside this bench); a variant whose flags the executable does not list in its --help is skipped
+// with a note, so the table can name flags that a later curvesfm adds. Every trajectory (init:
+// every registered frame; curves and hybrid: the keyframes; COLMAP: every registered image) is
+// compared with the set's ground truth from loadImageSequence by compareTrajectories (Sim(3),
 // core/trajectory_evaluation.h).
 //
 // Writes into --out: real_bench.csv (one row per set and variant), real_bench.md (the table, also
@@ -34,6 +36,7 @@
 // (no data folder, no known set in it), 2 for usage errors.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -41,6 +44,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <regex>
 #include <set>
@@ -113,6 +117,10 @@ struct BenchOptions {
   /// Shift per axis of a noise start, as a fraction of the median camera spacing (unitless).
   double noise_spacing_fraction = 0.01;
   double noise_rotation_deg = 0.1;  ///< Rotation per axis of a noise start (deg).
+  /// Diagnosis: the start ("truth" or "noiseN") whose poses lift and register every curve of
+  /// the truth and noise runs (`run --diagnose-frontend-poses`), so that a map and a start of
+  /// different errors meet; empty: each run lifts its map at its own start.
+  std::string map_at;
 };
 
 /// Where the curve pipeline's poses start: a --starts name and, for noise, its seed.
@@ -121,6 +129,18 @@ struct Start {
   int seed = 0;
   std::string label() const { return kind == "noise" ? "noise" + std::to_string(seed) : kind; }
 };
+
+/// The start a --map-at label names ("truth" or "noise" + seed); nullopt if it names none.
+std::optional<Start> startOfLabel(const std::string& label) {
+  if (label == "truth") return Start{"truth", 0};
+  const std::string prefix = "noise";
+  if (label.rfind(prefix, 0) != 0 || label.size() == prefix.size()) return std::nullopt;
+  const std::string digits = label.substr(prefix.size());
+  if (!std::all_of(digits.begin(), digits.end(), [](char c) { return std::isdigit(c) != 0; })) {
+    return std::nullopt;
+  }
+  return Start{"noise", std::stoi(digits)};
+}
 
 /// One row of the table: a set through one variant.
 struct Row {
@@ -774,6 +794,16 @@ std::vector<Start> startsOf(const Variant& variant, const BenchOptions& options)
   return starts;
 }
 
+/// `variant` with --map-at's poses as the poses that lift its map, when --map-at is given.
+Variant withMapAt(Variant variant, const ImageSequence& sequence, const BenchOptions& options,
+                  const fs::path& set_dir) {
+  if (options.map_at.empty() || variant.command != "run") return variant;
+  const std::string poses =
+      startPosesFile(*startOfLabel(options.map_at), sequence, {}, options, set_dir);
+  variant.flags.insert(variant.flags.end(), {"--diagnose-frontend-poses", poses});
+  return variant;
+}
+
 bool wantsColmapStart(const BenchOptions& options) {
   return std::find(options.starts.begin(), options.starts.end(), "colmap") != options.starts.end();
 }
@@ -797,8 +827,22 @@ std::vector<Variant> selectedVariants(const BenchOptions& options) {
   return variants;
 }
 
+// --map-at lifts the map in the ground truth's frame: only starts in that frame may use it.
+void checkMapAt(const BenchOptions& options) {
+  if (options.map_at.empty()) return;
+  for (const std::string& kind : options.starts) {
+    if (kind != "truth" && kind != "noise") {
+      throw InvalidOptions("BenchOptions", "map_at", options.map_at,
+                           "needs --starts of truth and noise only (" + kind +
+                               " starts are not in the ground truth's frame)")
+          .withFlag("map-at");
+    }
+  }
+}
+
 int run(const BenchOptions& options, const std::string& command) {
   const Clock::time_point start = Clock::now();
+  checkMapAt(options);
   if (!fs::is_directory(options.data)) {
     throw IoError(options.data, "no such folder (--data: the folder of the real sets)");
   }
@@ -884,8 +928,8 @@ int run(const BenchOptions& options, const std::string& command) {
           } else {
             const std::string init_poses =
                 startPosesFile(start, sequence, colmap_poses, options, set_dir);
-            runCurvesfm(options, variant, set, sequence, sequence_options, init_poses, &catalogue,
-                        dir, &row);
+            runCurvesfm(options, withMapAt(variant, sequence, options, set_dir), set, sequence,
+                        sequence_options, init_poses, &catalogue, dir, &row);
           }
         } catch (const Error& e) {
           row.status = "failed";
@@ -894,7 +938,10 @@ int run(const BenchOptions& options, const std::string& command) {
         if (row.status == "ok") {
           // The caps and flags that make this row differ from a plain run, then the run's note.
           std::vector<std::string> parts;
-          for (const std::string& part : {set_note, joinWords(variant.flags), row.note}) {
+          const std::string flags = joinWords(
+              variant.command == "run" ? withMapAt(variant, sequence, options, set_dir).flags
+                                       : variant.flags);
+          for (const std::string& part : {set_note, flags, row.note}) {
             if (!part.empty()) parts.push_back(part);
           }
           row.note = joinWords(parts, "; ");
@@ -1016,6 +1063,20 @@ int main(int argc, char** argv) {
                  "Noise start: rotation per axis (deg)")
       ->check(CLI::Range(0.0, 90.0))
       ->capture_default_str();
+  app.add_option_function<std::string>(
+         "--map-at",
+         [&options](const std::string& label) {
+           if (!curvesfm::startOfLabel(label)) {
+             throw CLI::ValidationError("--map-at", "'" + label +
+                                                        "' is not truth or noise<seed> (e.g. "
+                                                        "noise1)");
+           }
+           options.map_at = label;
+         },
+         "Diagnosis: lift and register every curve at these poses (truth, or noise<seed> as "
+         "--noise-seeds makes them) while BA starts from each run's own start; needs --starts "
+         "of truth and noise only")
+      ->default_str("");
   app.add_option("--threads", options.threads, "Threads of every solver and of COLMAP")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();

@@ -43,5 +43,19 @@ TEST(RealBenchCommandLine, NamesADataFolderWithoutTheSets) {
   EXPECT_THAT(r.output, HasSubstr("none of the benchmark's sets is there"));
 }
 
+TEST(RealBenchCommandLine, RejectsAMapAtLabelThatNamesNoStart) {
+  const testing::CommandResult r = runRealBench("--map-at noise");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--map-at: 'noise' is not truth or noise<seed>"));
+}
+
+TEST(RealBenchCommandLine, RejectsAMapAtWithStartsOutsideTheTruthsFrame) {
+  const std::string out = ::testing::TempDir() + "real_bench_map_at";
+  const testing::CommandResult r = runRealBench("--map-at truth --starts noise,init --data " +
+                                                ::testing::TempDir() + " --out " + out);
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--map-at = truth: needs --starts of truth and noise only"));
+}
+
 }  // namespace
 }  // namespace curvesfm

@@ -20,6 +20,7 @@
 #include "core/curve_export.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
+#include "core/median.h"
 #include "core/trajectory_evaluation.h"
 #include "core/tum_dataset.h"
 
@@ -199,8 +200,16 @@ nlohmann::json worstCurvesJson(const std::vector<CurveStatistics>& stats, CurveR
   return worst;
 }
 
+// Upper median of the curves' track lengths (keyframes observing them); 0 without curves.
+int medianTrackKeyframes(const std::vector<CurveStatistics>& stats) {
+  std::vector<double> keyframes;
+  for (const CurveStatistics& s : stats) keyframes.push_back(s.keyframes);
+  return keyframes.empty() ? 0 : static_cast<int>(upperMedian(keyframes));
+}
+
 nlohmann::json curveStatisticsJson(const std::vector<CurveStatistics>& stats) {
   return {{"file", "curves.csv"},
+          {"median_track_keyframes", medianTrackKeyframes(stats)},
           {"most_pull", worstCurvesJson(stats, CurveRanking::kPull)},
           {"highest_residual", worstCurvesJson(stats, CurveRanking::kResidual)}};
 }
@@ -219,10 +228,11 @@ void printCurveStatistics(const std::vector<CurveStatistics>& stats) {
   const std::size_t top = std::min<std::size_t>(10, shares.size());
   const double top_share = std::accumulate(shares.begin(), shares.begin() + top, 0.0);
   std::printf(
-      "curves: residual rms median %.2f px, 90th percentile %.2f px; the %zu curves pulling the "
-      "poses most hold %.0f %% of the pull (curves.csv, report.json curve_statistics)\n",
-      residuals[residuals.size() / 2], residuals[residuals.size() * 9 / 10], top,
-      100.0 * top_share);
+      "curves: track median %d keyframes; residual rms median %.2f px, 90th percentile %.2f px; "
+      "the %zu curves pulling the poses most hold %.0f %% of the pull (curves.csv, report.json "
+      "curve_statistics)\n",
+      medianTrackKeyframes(stats), residuals[residuals.size() / 2],
+      residuals[residuals.size() * 9 / 10], top, 100.0 * top_share);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -341,10 +351,16 @@ void printFrontendStages(const std::vector<KeyframeStats>& frames) {
       t.frontend_ms, t.slowest_frontend_ms);
 }
 
-// How the map grew over a run: curves started, and new curves appended to an existing one.
+// How the map grew over a run: curves started, new curves appended to an existing one, and
+// the registrations of map segments in later keyframes. Few registrations and many edge-distance
+// rejections mean short tracks: a map that keeps each keyframe's pose error instead of averaging
+// it (docs/benchmarks.md, "A noisy start over a held map").
 struct CurveGrowth {
   int started = 0;
   int extended = 0;
+  int registered = 0;
+  int rejected = 0;
+  int rejected_edge_distance = 0;
 };
 
 CurveGrowth curveGrowth(const std::vector<KeyframeStats>& frames) {
@@ -352,6 +368,9 @@ CurveGrowth curveGrowth(const std::vector<KeyframeStats>& frames) {
   for (const KeyframeStats& s : frames) {
     growth.started += s.new_curves;
     growth.extended += s.extended_curves;
+    growth.registered += s.registered_segments;
+    growth.rejected += s.rejectedSegments();
+    growth.rejected_edge_distance += s.rejected_edge_distance;
   }
   return growth;
 }
@@ -370,8 +389,11 @@ void printSummary(const RunInput& input, const PipelineResult& r, double seconds
       "%zu curves (%d segments) in the global map\n",
       input.frames.size(), images - static_cast<int>(input.frames.size()), images,
       r.keyframe_cam_from_world.size(), r.curves.size(), totalSegments(r.curves));
-  std::printf("map: %d curves started, %d new curves appended to an existing curve's end\n",
-              growth.started, growth.extended);
+  std::printf(
+      "map: %d curves started, %d new curves appended to an existing curve's end; %d segment "
+      "registrations in later keyframes, %d rejected (%d for edge distance)\n",
+      growth.started, growth.extended, growth.registered, growth.rejected,
+      growth.rejected_edge_distance);
   if (!r.global_ba.rounds.empty()) {
     std::printf("global BA: cost %.6g -> %.6g, %d iterations, %.2f s (%s)\n",
                 r.global_ba.initial_cost, r.global_ba.final_cost, r.global_ba.total_iterations,
@@ -695,6 +717,9 @@ int RunCommand::run() const {
          {"segments", totalSegments(result.curves)},
          {"curves_started", growth.started},
          {"curves_extended", growth.extended},
+         {"segments_registered", growth.registered},
+         {"registrations_rejected", growth.rejected},
+         {"registrations_rejected_edge_distance", growth.rejected_edge_distance},
          {"overlays", overlays},
          {"worst_curve_images", worst_curve_images}}},
        {"frames", frames},

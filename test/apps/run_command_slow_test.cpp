@@ -50,6 +50,18 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   // Every final curve was started once; extensions add none.
   EXPECT_GE(report["counts"]["curves_started"].get<int>(), report["counts"]["curves"].get<int>());
   EXPECT_GE(report["counts"]["curves_extended"].get<int>(), 0);
+  // Registrations of map segments in later keyframes, and the rejections, summed over frames.
+  int registered = 0, rejected_edge_distance = 0;
+  for (const auto& frame : report["frames"]) {
+    registered += frame["registered_segments"].get<int>();
+    rejected_edge_distance += frame["rejected_segments"]["edge_distance"].get<int>();
+  }
+  EXPECT_GT(registered, 0);
+  EXPECT_EQ(report["counts"]["segments_registered"].get<int>(), registered);
+  EXPECT_EQ(report["counts"]["registrations_rejected_edge_distance"].get<int>(),
+            rejected_edge_distance);
+  EXPECT_GE(report["counts"]["registrations_rejected"].get<int>(), rejected_edge_distance);
+  EXPECT_THAT(result.output, HasSubstr(" segment registrations in later keyframes, "));
   EXPECT_EQ(report["frames"].size(), 6u);
   EXPECT_EQ(report["options"]["pipeline"]["local_ba"]["strategy"], "alternating");
   EXPECT_EQ(report["options"]["pipeline"]["global_ba"]["optimizer"]["max_iterations"], 10);
@@ -69,7 +81,8 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_EQ(report["pose_stages"][0]["stage"], "incremental");
   EXPECT_LT(report["pose_stages"][0]["moved_rmse"].get<double>(), 1e-12);  // Local BA held them.
   EXPECT_THAT(result.output, HasSubstr("poses moved from the start (Sim(3) rmse, pose units): "));
-  EXPECT_THAT(result.output, HasSubstr("curves: residual rms median "));
+  EXPECT_THAT(result.output, HasSubstr("curves: track median "));
+  EXPECT_GE(report["curve_statistics"]["median_track_keyframes"].get<int>(), 2);
   EXPECT_EQ(report["curve_statistics"]["most_pull"].size(),
             std::min<std::size_t>(10, report["counts"]["curves"].get<std::size_t>()));
   std::ifstream csv(out + "/curves.csv");

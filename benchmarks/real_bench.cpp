@@ -134,8 +134,8 @@ struct Start {
 std::optional<Start> startOfLabel(const std::string& label) {
   if (label == "truth") return Start{"truth", 0};
   const std::string prefix = "noise";
-  if (label.rfind(prefix, 0) != 0 || label.size() == prefix.size()) return std::nullopt;
-  const std::string digits = label.substr(prefix.size());
+  const std::string digits = label.substr(std::min(label.size(), prefix.size()));
+  if (label.rfind(prefix, 0) != 0 || digits.empty() || digits.size() > 9) return std::nullopt;
   if (!std::all_of(digits.begin(), digits.end(), [](char c) { return std::isdigit(c) != 0; })) {
     return std::nullopt;
   }
@@ -917,6 +917,7 @@ int run(const BenchOptions& options, const std::string& command) {
         std::printf("[%zu/%d] %s %s%s: running\n", rows.size() + 1, total, set.name.c_str(),
                     variant.name.c_str(), row.start.empty() ? "" : (" from " + row.start).c_str());
         std::fflush(stdout);
+        Variant run_variant = variant;  // with --map-at's flag once its poses file exists
         try {
           if (variant.name == "colmap") {
             if (colmap.empty()) {
@@ -928,8 +929,9 @@ int run(const BenchOptions& options, const std::string& command) {
           } else {
             const std::string init_poses =
                 startPosesFile(start, sequence, colmap_poses, options, set_dir);
-            runCurvesfm(options, withMapAt(variant, sequence, options, set_dir), set, sequence,
-                        sequence_options, init_poses, &catalogue, dir, &row);
+            run_variant = withMapAt(variant, sequence, options, set_dir);
+            runCurvesfm(options, run_variant, set, sequence, sequence_options, init_poses,
+                        &catalogue, dir, &row);
           }
         } catch (const Error& e) {
           row.status = "failed";
@@ -938,10 +940,7 @@ int run(const BenchOptions& options, const std::string& command) {
         if (row.status == "ok") {
           // The caps and flags that make this row differ from a plain run, then the run's note.
           std::vector<std::string> parts;
-          const std::string flags = joinWords(
-              variant.command == "run" ? withMapAt(variant, sequence, options, set_dir).flags
-                                       : variant.flags);
-          for (const std::string& part : {set_note, flags, row.note}) {
+          for (const std::string& part : {set_note, joinWords(run_variant.flags), row.note}) {
             if (!part.empty()) parts.push_back(part);
           }
           row.note = joinWords(parts, "; ");

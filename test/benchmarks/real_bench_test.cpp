@@ -44,9 +44,12 @@ TEST(RealBenchCommandLine, NamesADataFolderWithoutTheSets) {
 }
 
 TEST(RealBenchCommandLine, RejectsAMapAtLabelThatNamesNoStart) {
-  const testing::CommandResult r = runRealBench("--map-at noise");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("--map-at: 'noise' is not truth or noise<seed>"));
+  for (const char* label : {"noise", "noise1x", "colmap", "noise12345678901234567890"}) {
+    const testing::CommandResult r = runRealBench(std::string("--map-at ") + label);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_THAT(r.output,
+                HasSubstr(std::string("--map-at: '") + label + "' is not truth or noise<seed>"));
+  }
 }
 
 TEST(RealBenchCommandLine, RejectsAMapAtWithStartsOutsideTheTruthsFrame) {

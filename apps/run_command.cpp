@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <numeric>
 #include <optional>
@@ -351,6 +353,19 @@ void printFrontendStages(const std::vector<KeyframeStats>& frames) {
       t.frontend_ms, t.slowest_frontend_ms);
 }
 
+// A line at most every `interval` seconds of a global BA (re-association rounds included), so
+// that a long solve never looks stuck; 0 prints every iteration.
+std::function<void(const IterationProgress&)> globalBaProgress(double interval) {
+  auto last_printed = std::make_shared<double>(0.0);
+  return [interval, last_printed](const IterationProgress& p) {
+    if (p.iteration == 0) *last_printed = 0.0;
+    if (p.iteration == 0 || p.seconds - *last_printed < interval) return;
+    *last_printed = p.seconds;
+    std::printf("global BA: iteration %d, cost %.6g, %.1f s\n", p.iteration, p.cost, p.seconds);
+    std::fflush(stdout);
+  };
+}
+
 // How the map grew over a run: curves started, new curves appended to an existing one, and
 // the registrations of map segments in later keyframes. Few registrations and many edge-distance
 // rejections mean short tracks: a map that keeps each keyframe's pose error instead of averaging
@@ -559,6 +574,9 @@ RunCommand::RunCommand(CLI::App* app) {
   c->add_option("--export-samples", export_samples_per_segment_,
                 "Samples per segment of the curves in curves.ply and curves.obj")
       ->capture_default_str();
+  c->add_option("--progress-interval", progress_interval_s_,
+                "Seconds between the progress lines of a global BA (0: one per iteration)")
+      ->capture_default_str();
   addImageSequenceOptions(&table_, &sequence_);
   addPointInitialiserOptions(&table_, &initialiser_, "/points");
   addPipelineOptions(&table_, &options_, "/pipeline");
@@ -575,12 +593,15 @@ void RunCommand::validate() const {
   require(export_samples_per_segment_ >= 1 && export_samples_per_segment_ <= 1000, "export-samples",
           export_samples_per_segment_, "in [1, 1000]");
   require(max_dt_ >= 0.0 && max_dt_ < 1e6, "max-dt", max_dt_, "finite and >= 0");
+  require(progress_interval_s_ >= 0.0 && progress_interval_s_ < 1e6, "progress-interval",
+          progress_interval_s_, "finite and >= 0");
 }
 
 nlohmann::json RunCommand::runOptionsJson() const {
   nlohmann::json options = table_.toJson();
   options["export_samples_per_segment"] = export_samples_per_segment_;
   options["max_dt"] = max_dt_;
+  options["progress_interval_s"] = progress_interval_s_;
   options["points_at_given_poses"] = points_at_given_poses_;
   options["diagnose_frontend_poses"] = frontend_poses_path_;
   return options;
@@ -660,7 +681,9 @@ int RunCommand::run() const {
               dataset_dir_.c_str(), d.layout.c_str(), input.frames.size(), d.images.size(),
               input.init_poses_source.c_str(), d.camera.width(), d.camera.height());
 
-  Pipeline pipeline(d.camera, options_);
+  PipelineOptions options = options_;
+  options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
+  Pipeline pipeline(d.camera, options);
   feedFrames(&pipeline, input);
   const PipelineResult result = pipeline.finish();
   const AteResult ate = evaluateAte(result, d);

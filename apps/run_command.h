@@ -50,6 +50,8 @@ class RunCommand {
   std::string init_poses_path_;
   bool overlays_ = false;
   int export_samples_per_segment_ = 20;
+  /// Seconds between the progress lines printed during a global BA (0: every iteration).
+  double progress_interval_s_ = 5.0;
   /// Largest |t_image - t_pose| of an image matched to an initial pose (s).
   double max_dt_ = 0.02;
   /// With given initial poses, the initialiser's tracks are triangulated at them: points for the

@@ -15,6 +15,19 @@ bool isSchur(LinearSolver solver) {
          solver == LinearSolver::kIterativeSchur;
 }
 
+// Hands every iteration of a solve to OptimizerOptions::on_iteration.
+class IterationHook : public ceres::IterationCallback {
+ public:
+  explicit IterationHook(const std::function<void(const IterationProgress&)>& hook) : hook_(hook) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    hook_({s.iteration, s.cost, s.cumulative_time_in_seconds, s.step_is_successful});
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::function<void(const IterationProgress&)>& hook_;
+};
+
 }  // namespace
 
 OptimizationSummary optimize(const FactorGraph& graph, Values* values, const ProblemConfig& config,
@@ -49,6 +62,8 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values, const Pro
   summary.num_free_variables = static_cast<int>(bridge.keys().size()) - bridge.numConstant();
   summary.setup_seconds = secondsSince(start);
 
+  IterationHook hook(options.on_iteration);
+  if (options.on_iteration) ceres_options.callbacks.push_back(&hook);
   const auto solve_start = Clock::now();
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(ceres_options, &bridge.problem(), &ceres_summary);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -45,6 +46,14 @@ struct EnumNames<TrustRegion> {
 };
 
 /// How to solve (the Ceres settings we expose).
+/// Where a running solve is, after one of its iterations (for a progress display).
+struct IterationProgress {
+  int iteration = 0;     ///< 0: the start, before any step.
+  double cost = 0.0;     ///< Cost after the iteration (Ceres' convention).
+  double seconds = 0.0;  ///< Since the solve started.
+  bool step_accepted = false;
+};
+
 struct OptimizerOptions {
   /// Linear solver of each step. Schur solvers eliminate structure (points, curve variables)
   /// first; iterative_schur uses the SCHUR_JACOBI preconditioner; sparse ones use SuiteSparse.
@@ -81,6 +90,9 @@ struct OptimizerOptions {
   /// Ceres inner iterations (a non-linear refinement of each step per independent block set).
   bool use_inner_iterations = false;
   bool verbose = false;  ///< Print Ceres' per-iteration log to stdout.
+  /// Called after every iteration, e.g. to print a progress line during a long solve; empty for
+  /// none. A hook for the program, not a tunable: no flag sets it and report.json omits it.
+  std::function<void(const IterationProgress&)> on_iteration;
 
   /// Throws InvalidOptions naming the field, its value and the constraint.
   void validate() const;

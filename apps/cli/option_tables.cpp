@@ -248,7 +248,10 @@ void addOptimizerOptions(OptionsTable* table, OptimizerOptions* o, const OptionP
                              "block per variable"))
       .boolean("use_inner_iterations", "inner-iterations", &o->use_inner_iterations,
                place.describe("Ceres inner iterations"))
-      .boolean("verbose", "verbose", &o->verbose, place.describe("print Ceres' iteration log"));
+      .boolean("verbose", "verbose", &o->verbose, place.describe("print Ceres' iteration log"))
+      .derived(
+          "on_iteration", [] { return nlohmann::json("a progress hook, set by the program"); },
+          "a progress hook the program sets (run: --progress-interval), not a tunable");
 }
 
 void addSchedulerOptions(OptionsTable* table, SchedulerOptions* s, const OptionPlace& place,

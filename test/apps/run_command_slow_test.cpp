@@ -28,9 +28,12 @@ using testing::runCurvesfm;
 TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   const std::string dataset = writeShortPlanarDataset();
   const std::string out = path("planar_out");
-  const CommandResult result = runCurvesfm("run --dataset " + dataset + " --out " + out +
-                                           " --overlays" + shortPlanarFlags());
+  const CommandResult result =
+      runCurvesfm("run --dataset " + dataset + " --out " + out + " --overlays" +
+                  " --progress-interval 0" + shortPlanarFlags());
   ASSERT_EQ(result.exit_code, 0) << result.output;
+  // With no interval, global BA prints a progress line per iteration.
+  EXPECT_THAT(result.output, HasSubstr("global BA: iteration 1, cost "));
   EXPECT_THAT(result.output, HasSubstr("frame 1/6 keyframe 0: curves "));
   EXPECT_THAT(result.output, HasSubstr("frame 6/6 keyframe 5: curves "));
   EXPECT_THAT(result.output, HasSubstr("run: 6 frames (0 of 6 images without an initial pose"));
@@ -45,6 +48,7 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   std::ifstream report_file(out + "/report.json");
   const nlohmann::json report = nlohmann::json::parse(report_file);
   EXPECT_EQ(report["curvesfm"], versionJson());
+  EXPECT_EQ(report["options"]["progress_interval_s"], 0.0);
   EXPECT_EQ(report["counts"]["keyframes"], 6);
   EXPECT_GT(report["counts"]["curves"].get<int>(), 0);
   // Every final curve was started once; extensions add none.

@@ -141,6 +141,9 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   result = run("--track-max-iterations -1");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--track-max-iterations = -1"));
+  result = run("--progress-interval -1");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("progress-interval = -1: finite and >= 0"));
   result = run("--sanity-extent-margin -1");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--sanity-extent-margin = -1: must be >= 0 and finite "

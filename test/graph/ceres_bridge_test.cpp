@@ -1,6 +1,7 @@
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 
@@ -186,6 +187,28 @@ TEST(Optimize, ReportsCostsInCeresConventionPerType) {
   for (const auto& entry : summary.final_cost_by_type) sum += entry.second.cost;
   EXPECT_NEAR(sum, summary.final_cost, 1e-9 + 1e-9 * summary.final_cost);
   EXPECT_NE(summary.toString().find("all_types"), std::string::npos);
+}
+
+TEST(Optimize, HandsEveryIterationToTheHookWithTheCostsOfTheSummary) {
+  ToyProblem toy = makeToyProblem();
+  Values values = toy.start;
+  std::vector<IterationProgress> seen;
+  OptimizerOptions options;
+  options.on_iteration = [&seen](const IterationProgress& p) { seen.push_back(p); };
+  const OptimizationSummary summary = optimize(toy.graph, &values, posesConstant(), options);
+  ASSERT_GE(summary.iterations, 1);
+  // Iteration 0 (the start), then one call per iteration, in order and in time.
+  ASSERT_EQ(seen.size(), static_cast<std::size_t>(summary.iterations) + 1);
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].iteration, static_cast<int>(i));
+    if (i > 0) {
+      EXPECT_GE(seen[i].seconds, seen[i - 1].seconds);
+    }
+  }
+  EXPECT_NEAR(seen.front().cost, summary.initial_cost, 1e-9 * summary.initial_cost);
+  EXPECT_TRUE(std::any_of(seen.begin() + 1, seen.end(),
+                          [](const IterationProgress& p) { return p.step_accepted; }));
+  EXPECT_NEAR(seen.back().cost, summary.final_cost, 1e-9 + 1e-9 * summary.final_cost);
 }
 
 TEST(Optimize, RobustLossIsTheKernelOfTheNoiseModel) {

@@ -45,15 +45,15 @@ struct EnumNames<TrustRegion> {
   }};
 };
 
-/// How to solve (the Ceres settings we expose).
 /// Where a running solve is, after one of its iterations (for a progress display).
 struct IterationProgress {
-  int iteration = 0;     ///< 0: the start, before any step.
-  double cost = 0.0;     ///< Cost after the iteration (Ceres' convention).
-  double seconds = 0.0;  ///< Since the solve started.
-  bool step_accepted = false;
+  int iteration = 0;           ///< 0: the start, before any step.
+  double cost = 0.0;           ///< Cost after the iteration (Ceres' convention).
+  double seconds = 0.0;        ///< Since the solve started.
+  bool step_accepted = false;  ///< The iteration's step lowered the cost and was kept.
 };
 
+/// How to solve (the Ceres settings we expose).
 struct OptimizerOptions {
   /// Linear solver of each step. Schur solvers eliminate structure (points, curve variables)
   /// first; iterative_schur uses the SCHUR_JACOBI preconditioner; sparse ones use SuiteSparse.
@@ -91,7 +91,8 @@ struct OptimizerOptions {
   bool use_inner_iterations = false;
   bool verbose = false;  ///< Print Ceres' per-iteration log to stdout.
   /// Called after every iteration, e.g. to print a progress line during a long solve; empty for
-  /// none. A hook for the program, not a tunable: no flag sets it and report.json omits it.
+  /// none. A hook for the program, not a tunable: no flag sets it, and report.json lists it
+  /// without a value.
   std::function<void(const IterationProgress&)> on_iteration;
 
   /// Throws InvalidOptions naming the field, its value and the constraint.

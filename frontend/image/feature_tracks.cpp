@@ -8,6 +8,7 @@
 #include "core/check.h"
 #include "core/clock.h"
 #include "core/errors.h"
+#include "core/union_find.h"
 
 namespace curvesfm {
 
@@ -41,25 +42,6 @@ std::vector<int> FeatureTracks::sharedTracks(int frame_a, int frame_b) const {
 }
 
 namespace {
-
-// Disjoint sets with path halving; the root of a set is its smallest node, so that the order of
-// the tracks does not depend on the order of the unions.
-class UnionFind {
- public:
-  explicit UnionFind(int n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-  int find(int x) {
-    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
-    return x;
-  }
-  void join(int a, int b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<int> parent_;
-};
 
 // A node of the correspondence graph before the KLT ids are all known: a KLT track id (>= 0) or
 // keypoint k as -(k + 1).

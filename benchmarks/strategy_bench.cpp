@@ -112,6 +112,7 @@ struct BenchOptions {
   bool quick = false;                      ///< One scene and a reduced sweep (smoke test).
   int max_iterations = 100;                ///< Ceres iterations per solve.
   bool curve_blocks = true;                ///< OptimizerOptions::curve_blocks.
+  bool components_apart = false;           ///< OptimizerOptions::solve_components_apart.
 };
 
 Run solve(const PreparedScene& prepared, const Config& config, const BenchOptions& options) {
@@ -125,6 +126,7 @@ Run solve(const PreparedScene& prepared, const Config& config, const BenchOption
   scheduler.optimizer.linear_solver = config.solver;
   scheduler.optimizer.max_iterations = options.max_iterations;
   scheduler.optimizer.curve_blocks = options.curve_blocks;
+  scheduler.optimizer.solve_components_apart = options.components_apart;
 
   const auto start = bench::Clock::now();
   CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(prepared.input, ba);
@@ -288,8 +290,10 @@ int run(const BenchOptions& options) {
   writeCsv(runs, out / "runs.csv");
   writeSummary(sweep, edge_runs, named, out / "summary.md");
 
-  std::printf("# strategy_bench: %d runs on %zu scenes, %s\n", total, scenes.size(),
-              options.curve_blocks ? "a solver block per curve" : "a solver block per variable");
+  std::printf("# strategy_bench: %d runs on %zu scenes, %s, %s\n", total, scenes.size(),
+              options.curve_blocks ? "a solver block per curve" : "a solver block per variable",
+              options.components_apart ? "structure-only steps per component"
+                                       : "structure-only steps in one Ceres solve");
   double ate_before = 0.0;
   for (const Run& run : runs) ate_before += 1e3 * run.before.position_ate_sim3;
   bench::print("ate_before_mm_mean", ate_before / runs.size());
@@ -323,6 +327,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--curve-blocks", options.curve_blocks,
                  "One solver block per curve (false: one per variable)")
+      ->capture_default_str();
+  app.add_option("--components-apart", options.components_apart,
+                 "With every pose held (alternating's structure step), solve each curve alone "
+                 "(false: one Ceres solve)")
       ->capture_default_str();
   return curvesfm::bench::parseAndRun(app, argc, argv, [&] { return curvesfm::run(options); });
 }

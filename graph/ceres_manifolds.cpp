@@ -144,18 +144,8 @@ Eigen::Matrix2d directionChartJacobian(const Direction& anchor, const Eigen::Vec
 }  // namespace
 
 void retractAnchored(VariableType type, const double* anchor, const double* delta, double* x) {
-  switch (type) {
-    case VariableType::kDirection:
-      Direction::fromAmbient(anchor).retract(Eigen::Vector2d::Map(delta)).toAmbient(x);
-      return;
-    case VariableType::kPoint3:
-    case VariableType::kScalar:
-      for (int i = 0; i < ambientDim(type); ++i) x[i] = anchor[i] + delta[i];
-      return;
-    case VariableType::kPose3:
-      break;
-  }
-  CURVESFM_CHECK(false) << "retractAnchored: poses have no anchored chart";
+  CURVESFM_CHECK(type != VariableType::kPose3) << "retractAnchored: poses have no anchored chart";
+  retractAmbient(type, anchor, delta, x);
 }
 
 void writeAnchoredJacobian(VariableType type, const double* anchor, const double* delta,

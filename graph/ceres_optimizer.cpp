@@ -5,6 +5,7 @@
 
 #include "core/clock.h"
 #include "graph/ceres_problem.h"
+#include "graph/component_solver.h"
 #include "graph/optimizer.h"
 
 namespace curvesfm {
@@ -33,6 +34,9 @@ class IterationHook : public ceres::IterationCallback {
 OptimizationSummary optimize(const FactorGraph& graph, Values* values, const ProblemConfig& config,
                              const OptimizerOptions& options) {
   options.validate();
+  if (options.solve_components_apart && !hasFreePose(graph, config)) {
+    return optimizeComponents(graph, values, config, options);
+  }
   const auto start = Clock::now();
   OptimizationSummary summary;
   summary.num_factors = static_cast<int>(graph.size());

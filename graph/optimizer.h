@@ -87,6 +87,13 @@ struct OptimizerOptions {
   /// A curve with more free tangent dimensions than this (7 per segment + 5) keeps a block per
   /// variable: every observation fills a Jacobian as wide as its curve's block; >= 1.
   int max_curve_block_size = 229;
+  /// With every pose held, solve each connected component of the free variables (each curve,
+  /// each point) alone with our own dense Levenberg-Marquardt (graph/component_solver.h) instead
+  /// of one Ceres solve over all of them, whose single trust region rejects every curve's step
+  /// when one curve overshoots. Same objective and tolerances; max_iterations then counts per
+  /// component. Off by default: the pipeline's local BA is 3x faster with it, but the planar
+  /// bench ends 10 % worse on average (docs/benchmarks.md, "Structure-only solves").
+  bool solve_components_apart = false;
   /// Ceres inner iterations (a non-linear refinement of each step per independent block set).
   bool use_inner_iterations = false;
   bool verbose = false;  ///< Print Ceres' per-iteration log to stdout.

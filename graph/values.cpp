@@ -36,6 +36,21 @@ int ambientDim(VariableType type) {
   return 0;
 }
 
+void retractAmbient(VariableType type, const double* x, const double* delta, double* out) {
+  switch (type) {
+    case VariableType::kPose3:
+      VariableTraits<Pose3>::retract(Pose3::fromAmbient(x), delta).toAmbient(out);
+      return;
+    case VariableType::kDirection:
+      VariableTraits<Direction>::retract(Direction::fromAmbient(x), delta).toAmbient(out);
+      return;
+    case VariableType::kPoint3:
+    case VariableType::kScalar:
+      for (int i = 0; i < ambientDim(type); ++i) out[i] = x[i] + delta[i];
+      return;
+  }
+}
+
 KeyDoesNotExist::KeyDoesNotExist(Key key, const std::string& operation)
     : Error("KeyDoesNotExist: Values::" + operation + ": no variable with key " +
             key.toString()) {}

@@ -78,5 +78,8 @@ struct VariableTraits<double> {
 /// Runtime versions of the traits' dimensions.
 int tangentDim(VariableType type);
 int ambientDim(VariableType type);
+/// Runtime retract on ambient coordinates: out = retract(x, delta) for a variable of `type`
+/// (delta has tangentDim(type) doubles; out may not alias x).
+void retractAmbient(VariableType type, const double* x, const double* delta, double* out);
 
 }  // namespace curvesfm

@@ -246,6 +246,9 @@ void addOptimizerOptions(OptionsTable* table, OptimizerOptions* o, const OptionP
       .number("max_curve_block_size", "max-curve-block", &o->max_curve_block_size,
               place.describe("a curve with more free dimensions (7 per segment + 5) keeps a "
                              "block per variable"))
+      .boolean("solve_components_apart", "components-apart", &o->solve_components_apart,
+               place.describe("with every pose held, solve each curve and point alone (own "
+                              "Levenberg-Marquardt; false: one Ceres solve)"))
       .boolean("use_inner_iterations", "inner-iterations", &o->use_inner_iterations,
                place.describe("Ceres inner iterations"))
       .boolean("verbose", "verbose", &o->verbose, place.describe("print Ceres' iteration log"))

@@ -406,6 +406,11 @@ TEST(Optimize, MissingOrMistypedVariablesThrowBeforeSolving) {
   mistyped.erase(startLengthKey(0, 0));
   mistyped.insert(startLengthKey(0, 0), Eigen::Vector3d::Zero());
   EXPECT_THROW(optimize(toy.graph, &mistyped, ProblemConfig(), OptimizerOptions()), IncorrectType);
+  // The same with every pose held, in the component solver.
+  OptimizerOptions apart;
+  apart.solve_components_apart = true;
+  EXPECT_THROW(optimize(toy.graph, &missing, posesConstant(), apart), KeyDoesNotExist);
+  EXPECT_THROW(optimize(toy.graph, &mistyped, posesConstant(), apart), IncorrectType);
 }
 
 TEST(OptimizerOptions, ValidateNamesFieldAndValue) {

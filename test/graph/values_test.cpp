@@ -90,5 +90,22 @@ TEST(Values, RetractMovesOnlyTheGivenKey) {
               0.1, 1e-12);
 }
 
+TEST(Values, RetractAmbientIsTheRetractOfEveryType) {
+  const Values values = makeValues();
+  const double delta[6] = {0.1, -0.2, 0.05, 0.3, -0.1, 0.2};
+  for (const Key key : values.keys()) {
+    const VariableType type = values.type(key);
+    double x[7];
+    double out[7];
+    double expected[7];
+    values.toAmbient(key, x);
+    retractAmbient(type, x, delta, out);
+    Values moved = values;
+    moved.retractInPlace(key, delta);
+    moved.toAmbient(key, expected);
+    for (int i = 0; i < ambientDim(type); ++i) EXPECT_DOUBLE_EQ(out[i], expected[i]) << key;
+  }
+}
+
 }  // namespace
 }  // namespace curvesfm

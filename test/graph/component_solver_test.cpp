@@ -1,0 +1,167 @@
+#include "graph/component_solver.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/so3.h"
+#include "graph/optimizer.h"
+#include "test/graph/test_factors.h"
+
+namespace curvesfm {
+namespace {
+
+using testing::AllTypesFactor;
+using testing::PointPriorFactor;
+
+constexpr int kGroups = 6;
+constexpr int kPoses = 4;
+
+// kGroups independent structures (a point, a direction and a scale each) seen through the same
+// kPoses poses, with noisy targets so that the optimum keeps a cost, and a Huber prior on every
+// point so that the kernel's weights matter.
+struct Scene {
+  FactorGraph graph;
+  Values start;
+};
+
+Scene makeScene() {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  Scene scene;
+  for (int i = 0; i < kPoses; ++i) {
+    scene.start.insert(poseKey(i), Pose3(so3::exp(Eigen::Vector3d(0.2 * i, -0.1, 0.3)),
+                                         Eigen::Vector3d(i, 0.5 * i, 1.0)));
+  }
+  const NoiseModel huber{0.1, RobustKernel(RobustKernelType::kHuber, 1.0)};
+  for (int g = 0; g < kGroups; ++g) {
+    const Eigen::Vector3d point(g, 1.0 - g, 2.0);
+    const Direction direction(Eigen::Vector3d(1.0, 0.2 * g, 0.5).normalized());
+    const double scale = 1.0 + 0.1 * g;
+    for (int i = 0; i < kPoses; ++i) {
+      const Pose3& pose = scene.start.at<Pose3>(poseKey(i));
+      const Eigen::Vector3d target = pose * (point + scale * direction.vector()) +
+                                     Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+      scene.graph.emplace<AllTypesFactor>(poseKey(i), pointKey(g), directionKey(g, 0),
+                                          startLengthKey(g, 0), target);
+    }
+    scene.graph.emplace<PointPriorFactor>(pointKey(g), point + Eigen::Vector3d(0.3, 0.0, 0.0),
+                                          huber);
+    scene.start.insert(pointKey(g), Eigen::Vector3d(point + Eigen::Vector3d(0.2, -0.1, 0.1)));
+    scene.start.insert(directionKey(g, 0), direction.retract(Eigen::Vector2d(0.2, -0.1)));
+    scene.start.insert(startLengthKey(g, 0), scale * 1.2);
+  }
+  return scene;
+}
+
+ProblemConfig posesHeld() {
+  ProblemConfig config;
+  config.setConstant(VariableCategory::kPose);
+  return config;
+}
+
+OptimizerOptions tight(bool apart) {
+  OptimizerOptions options;
+  options.solve_components_apart = apart;
+  options.max_iterations = 200;
+  options.function_tolerance = 1e-14;
+  options.gradient_tolerance = 1e-14;
+  options.parameter_tolerance = 1e-14;
+  return options;
+}
+
+TEST(OptimizeComponents, ReachesCeresOptimumOneComponentPerStructure) {
+  const Scene scene = makeScene();
+  Values ours = scene.start;
+  Values ceres = scene.start;
+  const OptimizationSummary apart = optimize(scene.graph, &ours, posesHeld(), tight(true));
+  const OptimizationSummary joint = optimize(scene.graph, &ceres, posesHeld(), tight(false));
+  EXPECT_EQ(apart.ordering, "components (6 solved apart)");
+  EXPECT_EQ(apart.linear_solver, "dense_cholesky_per_component");
+  EXPECT_EQ(apart.termination, "CONVERGENCE") << apart.message;
+  EXPECT_EQ(joint.linear_solver, "SPARSE_NORMAL_CHOLESKY");
+  EXPECT_NEAR(apart.initial_cost, joint.initial_cost, 1e-12 * joint.initial_cost);
+  EXPECT_GT(apart.final_cost, 1e-3);  // The noisy targets leave a cost at the optimum.
+  EXPECT_NEAR(apart.final_cost, joint.final_cost, 1e-9 * joint.final_cost);
+  double sum = 0.0;
+  for (const auto& [type, cost] : apart.final_cost_by_type) sum += cost.cost;
+  EXPECT_NEAR(sum, apart.final_cost, 1e-9 * apart.final_cost);
+  for (int g = 0; g < kGroups; ++g) {
+    EXPECT_LT(
+        (ours.at<Eigen::Vector3d>(pointKey(g)) - ceres.at<Eigen::Vector3d>(pointKey(g))).norm(),
+        1e-7);
+    EXPECT_LT(
+        ours.at<Direction>(directionKey(g, 0)).angleTo(ceres.at<Direction>(directionKey(g, 0))),
+        1e-7);
+    EXPECT_NEAR(ours.at<double>(startLengthKey(g, 0)), ceres.at<double>(startLengthKey(g, 0)),
+                1e-7);
+  }
+  for (int i = 0; i < kPoses; ++i) {
+    EXPECT_TRUE(ours.at<Pose3>(poseKey(i)).translation() ==
+                scene.start.at<Pose3>(poseKey(i)).translation());
+  }
+  EXPECT_EQ(apart.num_free_variables, 3 * kGroups);
+  EXPECT_EQ(apart.num_constant_variables, kPoses);
+  EXPECT_EQ(apart.num_effective_parameters, 6 * kGroups);
+  EXPECT_EQ(apart.num_residuals, joint.num_residuals);
+}
+
+TEST(OptimizeComponents, TheResultDoesNotDependOnTheThreadCount) {
+  const Scene scene = makeScene();
+  Values one = scene.start;
+  Values two = scene.start;
+  OptimizerOptions options;
+  options.solve_components_apart = true;
+  optimize(scene.graph, &one, posesHeld(), options);
+  options.num_threads = 2;
+  optimize(scene.graph, &two, posesHeld(), options);
+  for (int g = 0; g < kGroups; ++g) {
+    EXPECT_TRUE(one.at<Eigen::Vector3d>(pointKey(g)) == two.at<Eigen::Vector3d>(pointKey(g)));
+    EXPECT_EQ(one.at<double>(startLengthKey(g, 0)), two.at<double>(startLengthKey(g, 0)));
+  }
+}
+
+TEST(OptimizeComponents, MaxIterationsCountsPerComponent) {
+  const Scene scene = makeScene();
+  Values values = scene.start;
+  OptimizerOptions options = tight(true);
+  options.max_iterations = 1;
+  const OptimizationSummary summary = optimize(scene.graph, &values, posesHeld(), options);
+  EXPECT_EQ(summary.iterations, 1);
+  EXPECT_EQ(summary.termination, "NO_CONVERGENCE");
+  EXPECT_LT(summary.final_cost, summary.initial_cost);
+  EXPECT_NE(summary.message.find("6 stopped at 1 iterations"), std::string::npos)
+      << summary.message;
+}
+
+TEST(OptimizeComponents, AFreePoseJoinsItsStructureIntoOneComponent) {
+  const Scene scene = makeScene();
+  Values values = scene.start;
+  ProblemConfig config;
+  for (int i = 1; i < kPoses; ++i) config.setConstant(poseKey(i));
+  // optimize() hands a free pose to Ceres; the component solver itself takes it as one component.
+  EXPECT_TRUE(hasFreePose(scene.graph, config));
+  EXPECT_FALSE(hasFreePose(scene.graph, posesHeld()));
+  const OptimizationSummary summary = optimizeComponents(scene.graph, &values, config, tight(true));
+  EXPECT_EQ(summary.ordering, "components (1 solved apart)");
+  EXPECT_EQ(summary.termination, "CONVERGENCE") << summary.message;
+  EXPECT_LT(summary.final_cost, summary.initial_cost);
+}
+
+TEST(OptimizeComponents, TheHookSeesTheStartAndTheEnd) {
+  const Scene scene = makeScene();
+  Values values = scene.start;
+  std::vector<IterationProgress> seen;
+  OptimizerOptions options;
+  options.solve_components_apart = true;
+  options.on_iteration = [&seen](const IterationProgress& p) { seen.push_back(p); };
+  const OptimizationSummary summary = optimize(scene.graph, &values, posesHeld(), options);
+  ASSERT_EQ(seen.size(), 2u);
+  EXPECT_EQ(seen[0].iteration, 0);
+  EXPECT_NEAR(seen[0].cost, summary.initial_cost, 1e-9 * summary.initial_cost);
+  EXPECT_EQ(seen[1].iteration, summary.iterations);
+  EXPECT_NEAR(seen[1].cost, summary.final_cost, 1e-9 * summary.final_cost);
+}
+
+}  // namespace
+}  // namespace curvesfm

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <sstream>
 #include <thread>
 #include <unordered_map>
@@ -43,8 +44,6 @@ struct Component {
 };
 
 struct ComponentResult {
-  double initial_cost = 0.0;
-  double final_cost = 0.0;
   int iterations = 0;
   int rejected = 0;  // Iterations whose step was not kept.
   bool converged = false;
@@ -55,8 +54,7 @@ struct Setup {
   std::vector<Slot> slots;
   std::vector<double> ambient;
   std::vector<std::vector<int>> factor_slots;  // Per graph factor, its keys' slots.
-  std::vector<Component> components;
-  std::vector<int> fixed_factors;  // Factors without a free variable: constant cost.
+  std::vector<Component> components;           // Factors without a free variable are in none.
 };
 
 Setup makeSetup(const FactorGraph& graph, const Values& values, const ProblemConfig& config) {
@@ -104,9 +102,7 @@ Setup makeSetup(const FactorGraph& graph, const Values& values, const ProblemCon
   for (std::size_t f = 0; f < graph.size(); ++f) {
     const auto free_slot = std::find_if(setup.factor_slots[f].begin(), setup.factor_slots[f].end(),
                                         [&](int s) { return setup.slots[s].free; });
-    if (free_slot == setup.factor_slots[f].end()) {
-      setup.fixed_factors.push_back(static_cast<int>(f));
-    } else {
+    if (free_slot != setup.factor_slots[f].end()) {
       setup.components[componentOf(*free_slot)].factors.push_back(static_cast<int>(f));
     }
   }
@@ -305,7 +301,6 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
   Eigen::MatrixXd H(n, n);
   Eigen::VectorXd g(n);
   double cost = problem->evaluate(*x, &H, &g);
-  result.initial_cost = cost;
   double radius = options.initial_trust_region_radius;
   double decrease_factor = 2.0;
   std::vector<double> candidate;
@@ -347,8 +342,13 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
       result.converged = radius < kMinTrustRegionRadius;
     }
   }
-  result.final_cost = cost;
   return result;
+}
+
+double totalCost(const std::map<std::string, FactorTypeCost>& by_type) {
+  double total = 0.0;
+  for (const auto& [type, cost] : by_type) total += cost.cost;
+  return total;
 }
 
 }  // namespace
@@ -376,8 +376,6 @@ OptimizationSummary optimizeComponents(const FactorGraph& graph, Values* values,
     if (slot.free) summary.num_effective_parameters += tangentDim(slot.type);
   }
   for (const auto& factor : graph) summary.num_residuals += factor->residualDimension();
-  double fixed_cost = 0.0;
-  for (const int f : setup.fixed_factors) fixed_cost += graph[f]->cost(*values);
   summary.setup_seconds = secondsSince(start);
 
   const auto solve_start = Clock::now();
@@ -394,9 +392,7 @@ OptimizationSummary optimizeComponents(const FactorGraph& graph, Values* values,
     }
   };
   if (options.on_iteration) {
-    double initial_cost = 0.0;
-    for (const auto& [type, cost] : summary.initial_cost_by_type) initial_cost += cost.cost;
-    options.on_iteration({0, initial_cost, secondsSince(start), false});
+    options.on_iteration({0, totalCost(summary.initial_cost_by_type), secondsSince(start), false});
   }
   const int num_threads = std::min(options.num_threads, std::max(1, num_components));
   std::vector<std::thread> threads;
@@ -416,10 +412,10 @@ OptimizationSummary optimizeComponents(const FactorGraph& graph, Values* values,
   int converged = 0;
   long total_iterations = 0;
   long rejected = 0;
-  summary.initial_cost = summary.final_cost = fixed_cost;
+  // Every factor's cost, those without a free variable included, as Ceres counts them.
+  summary.initial_cost = totalCost(summary.initial_cost_by_type);
+  summary.final_cost = totalCost(summary.final_cost_by_type);
   for (const ComponentResult& r : results) {
-    summary.initial_cost += r.initial_cost;
-    summary.final_cost += r.final_cost;
     summary.iterations = std::max(summary.iterations, r.iterations);
     converged += r.converged ? 1 : 0;
     total_iterations += r.iterations;

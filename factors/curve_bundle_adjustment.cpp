@@ -124,7 +124,8 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
   }
 
   const auto sampling = std::make_shared<const CurveSampling>(
-      options.samples_per_segment + 1, options.use_subpixel_edges, options.max_normal_angle_deg);
+      options.samples_per_segment + 1, options.use_subpixel_edges, options.max_normal_angle_deg,
+      options.interpolate_edges);
   const NoiseModel pixel_noise{options.pixel_sigma,
                                RobustKernel(options.kernel, options.kernel_width)};
   const int num_curves = static_cast<int>(input.curves.size());

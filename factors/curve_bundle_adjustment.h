@@ -34,6 +34,10 @@ struct CurveBundleAdjustmentOptions {
   /// Lower values remove most of the bias of partly hidden curves but cap more samples of a
   /// poor start (docs/benchmarks.md, "Curve bundle adjustment").
   double max_normal_angle_deg = 90.0;
+  /// Blend the residuals to the nearest edges of the four pixel centres around each sample, so
+  /// that the residual does not jump as a sample crosses a pixel boundary
+  /// (CurveSampling::interpolate_edges).
+  bool interpolate_edges = false;
   double pixel_sigma = 1.0;                            ///< Std dev of an edge residual (px); > 0.
   RobustKernelType kernel = RobustKernelType::kHuber;  ///< Kernel on edge residuals.
   double kernel_width = 2.0;  ///< Kernel width in sigmas (px at sigma 1); > 0.

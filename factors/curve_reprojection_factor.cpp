@@ -30,12 +30,14 @@ BezierSegmentParams segmentParams(const Eigen::Vector3d& q0, const Eigen::Vector
 
 }  // namespace
 
-CurveSampling::CurveSampling(int num_samples, bool use_subpixel_edges, double max_normal_angle_deg)
+CurveSampling::CurveSampling(int num_samples, bool use_subpixel_edges, double max_normal_angle_deg,
+                             bool interpolate_edges)
     : point_weights(4, num_samples),
       tangent_weights(4, num_samples),
       use_subpixel_edges(use_subpixel_edges),
       max_normal_angle_deg(max_normal_angle_deg),
-      sin_max_normal_angle(std::sin(max_normal_angle_deg * M_PI / 180.0)) {
+      sin_max_normal_angle(std::sin(max_normal_angle_deg * M_PI / 180.0)),
+      interpolate_edges(interpolate_edges) {
   CURVESFM_CHECK(num_samples >= 2 && num_samples <= CurveReprojectionFactor::kMaxSamples)
       << "CurveSampling: " << num_samples << " samples, expected 2.."
       << CurveReprojectionFactor::kMaxSamples;
@@ -78,7 +80,60 @@ struct CurveReprojectionFactor::SampleBatch {
   std::array<Matrix23d, kMaxSamples> d_pixel_d_cam;
   std::array<const EdgePixel*, kMaxSamples> edge;  // null unless kOnField
   std::array<SampleOutcome, kMaxSamples> outcome;
+  std::array<double, kMaxSamples> residual;           // r_k (px), where kOnField
+  std::array<Eigen::Vector2d, kMaxSamples> gradient;  // dr_k / d pixel, where kOnField
 };
+
+Eigen::Vector2d CurveReprojectionFactor::edgePosition(const EdgePixel& edge) const {
+  return (sampling_->use_subpixel_edges ? edge.subpixel : edge.pixel).cast<double>();
+}
+
+void CurveReprojectionFactor::measureSample(const Eigen::Vector2d& pixel, const EdgePixel& nearest,
+                                            double* residual, Eigen::Vector2d* gradient) const {
+  const Eigen::Vector2d normal = nearest.normal.cast<double>();
+  const Eigen::Vector2d position = edgePosition(nearest);
+  *residual = (pixel - position).dot(normal);
+  *gradient = normal;
+  if (!sampling_->interpolate_edges) return;
+
+  // Corners (x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1): pixel centres at integers.
+  const double x0 = std::floor(pixel.x()), y0 = std::floor(pixel.y());
+  const std::array<const EdgePixel*, 4> corner = {
+      field_->nearest(x0, y0), field_->nearest(x0 + 1.0, y0), field_->nearest(x0, y0 + 1.0),
+      field_->nearest(x0 + 1.0, y0 + 1.0)};
+  const double fx = pixel.x() - x0, fy = pixel.y() - y0;
+  const std::array<double, 4> weight = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+  const std::array<Eigen::Vector2d, 4> d_weight = {
+      Eigen::Vector2d(-(1 - fy), -(1 - fx)), Eigen::Vector2d(1 - fy, -fx),
+      Eigen::Vector2d(-fy, 1 - fx), Eigen::Vector2d(fy, fx)};
+  // Only corners whose edge continues the nearest one's line join the blend; the others count
+  // with the nearest edge's residual. Blending the signed distances to two different edges
+  // would make a false zero between them.
+  const double nearest_residual = *residual;
+  *residual = 0.0;
+  gradient->setZero();
+  for (int i = 0; i < 4; ++i) {
+    double r = nearest_residual;
+    Eigen::Vector2d n = normal;
+    if (corner[i] && continuesEdge(*corner[i], position, normal)) {
+      n = corner[i]->normal.cast<double>();
+      if (n.dot(normal) < 0.0) n = -n;
+      r = (pixel - edgePosition(*corner[i])).dot(n);
+    }
+    *residual += weight[i] * r;
+    *gradient += weight[i] * n + r * d_weight[i];
+  }
+}
+
+bool CurveReprojectionFactor::continuesEdge(const EdgePixel& edge, const Eigen::Vector2d& position,
+                                            const Eigen::Vector2d& normal) const {
+  // Within kMaxLineOffsetPx of the nearest edge's line, and at most 45 deg off its normal either
+  // way (the sign of a normal is the contrast's, not the edge's).
+  constexpr double kMaxLineOffsetPx = 0.5;
+  constexpr double kMinNormalCosine = 0.7071;
+  return std::abs((edgePosition(edge) - position).dot(normal)) <= kMaxLineOffsetPx &&
+         std::abs(edge.normal.cast<double>().dot(normal)) >= kMinNormalCosine;
+}
 
 void CurveReprojectionFactor::locateSamples(const Pose3& cam_from_world, const Eigen::Matrix3d& R,
                                             const SegmentEvaluator& segment, bool with_jacobians,
@@ -111,15 +166,24 @@ void CurveReprojectionFactor::locateSamples(const Pose3& cam_from_world, const E
                                                                     : SampleOutcome::kOutsideImage;
       continue;
     }
-    if (!check_orientation) continue;
-    // The edge normal must be (nearly) normal to the projected tangent t: |g . t| <= sin * |t|.
-    const Eigen::Vector2d tangent =
-        b.d_pixel_d_cam[k] * (R * segment.evaluate(sampling_->tangent_weights.col(k)));
-    if (std::abs(b.edge[k]->normal.cast<double>().dot(tangent)) >
-        sampling_->sin_max_normal_angle * tangent.norm()) {
-      b.outcome[k] = SampleOutcome::kWrongOrientation;
-      b.edge[k] = nullptr;
+    if (check_orientation) checkOrientation(k, R, segment, &b);
+    if (b.outcome[k] == SampleOutcome::kOnField) {
+      measureSample(b.pixel[k], *b.edge[k], &b.residual[k], &b.gradient[k]);
     }
+  }
+}
+
+void CurveReprojectionFactor::checkOrientation(int k, const Eigen::Matrix3d& R,
+                                               const SegmentEvaluator& segment,
+                                               SampleBatch* batch) const {
+  // The edge normal must be (nearly) normal to the projected tangent t: |g . t| <= sin * |t|.
+  SampleBatch& b = *batch;
+  const Eigen::Vector2d tangent =
+      b.d_pixel_d_cam[k] * (R * segment.evaluate(sampling_->tangent_weights.col(k)));
+  if (std::abs(b.edge[k]->normal.cast<double>().dot(tangent)) >
+      sampling_->sin_max_normal_angle * tangent.norm()) {
+    b.outcome[k] = SampleOutcome::kWrongOrientation;
+    b.edge[k] = nullptr;
   }
 }
 
@@ -160,14 +224,11 @@ CurveReprojectionFactor::Error CurveReprojectionFactor::evaluateError(
       if (H_d2) (*H_d2)[k] = 0.0;
       continue;
     }
-    const Eigen::Vector2d normal = edge->normal.cast<double>();
-    const Eigen::Vector2d edge_position =
-        (sampling_->use_subpixel_edges ? edge->subpixel : edge->pixel).cast<double>();
-    error[k] = (batch.pixel[k] - edge_position).dot(normal);
+    error[k] = batch.residual[k];
     if (!wants_jacobians) continue;
 
     segment.evaluate(sampling_->point_weights.col(k), &d_B);
-    const Eigen::RowVector3d d_r_d_cam = normal.transpose() * batch.d_pixel_d_cam[k];
+    const Eigen::RowVector3d d_r_d_cam = batch.gradient[k].transpose() * batch.d_pixel_d_cam[k];
     const Eigen::RowVector3d d_r_d_point = d_r_d_cam * R;
     if (H_pose) {
       // d(exp(w) R p + t + u)/d[w; u] = [-[R p]x, I], and -a^T [b]x = (b x a)^T.

@@ -30,7 +30,8 @@ struct CurveSampleCounts {
 struct CurveSampling {
   /// `num_samples` = s + 1 samples at t_k = k / s (uniformBernsteinWeights), 2 <= s + 1 <=
   /// CurveReprojectionFactor::kMaxSamples; 0 < max_normal_angle_deg <= 90. Throws CheckError.
-  CurveSampling(int num_samples, bool use_subpixel_edges, double max_normal_angle_deg = 90.0);
+  CurveSampling(int num_samples, bool use_subpixel_edges, double max_normal_angle_deg = 90.0,
+                bool interpolate_edges = false);
 
   int numSamples() const { return static_cast<int>(point_weights.cols()); }
 
@@ -45,6 +46,15 @@ struct CurveSampling {
   /// 90 accepts every match.
   double max_normal_angle_deg = 90.0;
   double sin_max_normal_angle = 1.0;  ///< sin(max_normal_angle_deg), for the inner loop.
+  /// Blend the residuals to the nearest edges of the four pixel centres around the sample,
+  /// bilinearly, instead of using the one nearest pixel's edge. The nearest edge pixel changes
+  /// as a sample crosses a pixel boundary, and with it the residual jumps by up to a fraction of
+  /// a pixel: a solver that converges tightly parks samples on the favourable side of such
+  /// jumps, and then every step of a later joint solve looks worse. Blended, the residual is
+  /// continuous along an edge. Only corners whose edge continues the sample's nearest edge
+  /// blend: the signed distances to two edges a pixel apart would blend to a false zero between
+  /// them. Where the nearest edge itself changes to another edge the residual still jumps.
+  bool interpolate_edges = false;
 };
 
 /// The geometric term E_geo of one (segment, keyframe) pair (paper §3.1, eq. 6): samples
@@ -54,7 +64,10 @@ struct CurveSampling {
 /// sub-pixel position, or its pixel centre if `use_subpixel_edges` is off) and g the unit image
 /// gradient there. eta and g are constant within one evaluation: the residual measures distance
 /// across the edge only, so a sample may slide along it, which is what keeps a partly observed
-/// curve unbiased.
+/// curve unbiased. With CurveSampling::interpolate_edges the residual is the bilinear blend of
+/// the residuals to the nearest edges of the four pixel centres around x_k, where those continue
+/// the line of the sample's own nearest edge (else its residual stands in), and its Jacobian
+/// includes the weights' derivatives.
 ///
 /// A sample that projects behind the camera, outside the image, farther than the field's reach R
 /// from every edge, or onto an edge of the wrong orientation (CurveSampling::max_normal_angle_deg)
@@ -105,6 +118,18 @@ class CurveReprojectionFactor
   void locateSamples(const Pose3& cam_from_world, const Eigen::Matrix3d& R,
                      const SegmentEvaluator& segment, bool with_jacobians,
                      SampleBatch* batch) const;
+  /// Caps sample k if its edge normal is too far from the projected curve's normal.
+  void checkOrientation(int k, const Eigen::Matrix3d& R, const SegmentEvaluator& segment,
+                        SampleBatch* batch) const;
+  /// The residual of a sample at `pixel` whose nearest edge pixel is `nearest`, and its
+  /// derivative with respect to the pixel (CurveSampling::interpolate_edges).
+  void measureSample(const Eigen::Vector2d& pixel, const EdgePixel& nearest, double* residual,
+                     Eigen::Vector2d* gradient) const;
+  Eigen::Vector2d edgePosition(const EdgePixel& edge) const;
+  /// Whether `edge` lies on the line of the edge at `position` with unit `normal` (a neighbour
+  /// pixel of the same edge), so that their residuals may be blended.
+  bool continuesEdge(const EdgePixel& edge, const Eigen::Vector2d& position,
+                     const Eigen::Vector2d& normal) const;
 
   std::shared_ptr<const NearestEdgeField> field_;
   std::shared_ptr<const Camera> camera_;

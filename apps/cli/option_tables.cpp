@@ -287,6 +287,9 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
       .number("max_normal_angle_deg", "max-normal-angle", &b->max_normal_angle_deg,
               "Match only edges whose normal is within this angle of the curve's (deg); 90 "
               "accepts every match")
+      .boolean("interpolate_edges", "interpolate-edges", &b->interpolate_edges,
+               "Blend the residuals to the nearest edges of the four pixel centres around a "
+               "sample, so that it does not jump between pixels")
       .number("pixel_sigma", "pixel-sigma", &b->pixel_sigma, "Std dev of an edge residual (px)")
       .enumeration("kernel", "kernel", &b->kernel, "Robust kernel on edge residuals")
       .number("kernel_width", "kernel-width", &b->kernel_width, "Kernel width (sigmas)")

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
 #include <random>
 
 #include "core/bezier.h"
@@ -93,10 +94,12 @@ Values randomConfiguration(std::mt19937& rng) {
 
 CurveReprojectionFactor makeFactor(std::shared_ptr<const NearestEdgeField> field,
                                    std::shared_ptr<const Camera> camera, int num_samples = 11,
-                                   bool subpixel = true, double max_normal_angle_deg = 90.0) {
+                                   bool subpixel = true, double max_normal_angle_deg = 90.0,
+                                   bool interpolate_edges = false) {
   return CurveReprojectionFactor(
       poseKey(0), kSegment, std::move(field), std::move(camera),
-      std::make_shared<const CurveSampling>(num_samples, subpixel, max_normal_angle_deg),
+      std::make_shared<const CurveSampling>(num_samples, subpixel, max_normal_angle_deg,
+                                            interpolate_edges),
       NoiseModel{});
 }
 
@@ -125,6 +128,27 @@ TEST(CurveReprojectionFactor, SubpixelSwitchUsesTheRefinedEdgePosition) {
   EXPECT_TRUE(refined.isConstant(420.0 - refined_x, 1e-6)) << refined.transpose();
 }
 
+// Every pixel an edge, its normal turning slowly over the image (as along real edges, where
+// neighbouring edge pixels agree to well under 90 deg) with a little noise, and random gradient
+// magnitudes, so that the sub-pixel positions scatter about the pixel centres.
+std::shared_ptr<const NearestEdgeField> smoothDenseField(unsigned seed) {
+  const cv::Mat edges(kHeight, kWidth, CV_8UC1, cv::Scalar(255));
+  cv::Mat grad_x(kHeight, kWidth, CV_32FC1);
+  cv::Mat grad_y(kHeight, kWidth, CV_32FC1);
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0f, 1.0f);
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      const float angle = 0.02f * x + 0.015f * y + 0.1f * noise(rng);
+      const float magnitude = 1.0f + 0.3f * std::abs(noise(rng));
+      grad_x.at<float>(y, x) = magnitude * std::cos(angle);
+      grad_y.at<float>(y, x) = magnitude * std::sin(angle);
+    }
+  }
+  return std::make_shared<const NearestEdgeField>(
+      NearestEdgeField::build(edges, grad_x, grad_y, NearestEdgeFieldOptions{}));
+}
+
 TEST(CurveReprojectionFactor, JacobiansMatchNumericalAtRandomConfigurations) {
   std::mt19937 rng(5);
   const auto field = randomDenseField(7);
@@ -134,6 +158,61 @@ TEST(CurveReprojectionFactor, JacobiansMatchNumericalAtRandomConfigurations) {
     ASSERT_EQ(factor.sampleCounts(values).on_field, 11) << "trial " << trial;
     testing::expectJacobiansMatchNumerical(factor, values, 1e-5);
   }
+}
+
+TEST(CurveReprojectionFactor, InterpolatedJacobiansMatchNumericalAtRandomConfigurations) {
+  std::mt19937 rng(6);
+  const auto field = smoothDenseField(8);
+  for (int trial = 0; trial < 30; ++trial) {
+    const Values values = randomConfiguration(rng);
+    const auto factor = makeFactor(field, distortedCamera(), 11, trial % 2 == 0, 90.0, true);
+    ASSERT_EQ(factor.sampleCounts(values).on_field, 11) << "trial " << trial;
+    // The blend is continuous, but its derivative changes at pixel boundaries: a tiny step keeps
+    // central differences from straddling one.
+    testing::expectJacobiansMatchNumerical(factor, values, 1e-5, 1e-8);
+  }
+}
+
+// The edges of a bright disc of radius 100 px about (520, 240), rendered anti-aliased and
+// blurred a little, through Sobel and Canny as the frontend does: a curved edge, whose pixels'
+// normals and sub-pixel positions change from one edge pixel to the next.
+std::shared_ptr<const NearestEdgeField> discEdgeField() {
+  cv::Mat image(kHeight, kWidth, CV_8UC1, cv::Scalar(40));
+  cv::circle(image, cv::Point(520 * 16, 240 * 16), 100 * 16, cv::Scalar(200), cv::FILLED,
+             cv::LINE_AA, 4);
+  cv::GaussianBlur(image, image, cv::Size(5, 5), 1.0);
+  cv::Mat grad_x, grad_y, edges;
+  cv::Sobel(image, grad_x, CV_32F, 1, 0);
+  cv::Sobel(image, grad_y, CV_32F, 0, 1);
+  cv::Canny(image, edges, 50, 100);
+  return std::make_shared<const NearestEdgeField>(
+      NearestEdgeField::build(edges, grad_x, grad_y, NearestEdgeFieldOptions{}));
+}
+
+// The largest change of any sample's residual between consecutive positions of a segment slid
+// sideways in steps of 0.01 px across three pixel columns, over the disc's left edge: the
+// vertical segment at x = 0.4 m, 2 m deep, projects to column 420, the disc's leftmost column.
+double largestResidualStep(bool interpolate_edges) {
+  const auto factor =
+      makeFactor(discEdgeField(), pinholeCamera(), 11, true, 90.0, interpolate_edges);
+  // 0.00004 m at depth 2 m is 500 * 0.00004 / 2 = 0.01 px.
+  Eigen::VectorXd previous = factor.unwhitenedError(straightSegment(0.4 - 0.00004 * 150));
+  double largest = 0.0;
+  for (int step = -149; step <= 150; ++step) {
+    const Eigen::VectorXd error = factor.unwhitenedError(straightSegment(0.4 + 0.00004 * step));
+    largest = std::max(largest, (error - previous).cwiseAbs().maxCoeff());
+    previous = error;
+  }
+  return largest;
+}
+
+TEST(CurveReprojectionFactor, InterpolatedResidualDoesNotJumpAtPixelBoundaries) {
+  // The nearest edge pixel's residual jumps where a sample crosses into the next pixel (here by
+  // up to 0.03 px, from the curvature and the sub-pixel scatter); the blend moves with the
+  // sample, by about the 0.01 px step.
+  const double nearest = largestResidualStep(false), blended = largestResidualStep(true);
+  EXPECT_GT(nearest, 0.02);
+  EXPECT_LT(blended, 0.0125);
 }
 
 TEST(CurveReprojectionFactor, JacobiansMatchNumericalOnAStraightEdge) {

@@ -47,15 +47,15 @@ inline Eigen::MatrixXd numericalJacobian(const Factor& factor, const Values& val
   return jacobian;
 }
 
-/// Every analytic Jacobian of `factor` at `values` agrees with central differences to
+/// Every analytic Jacobian of `factor` at `values` agrees with central differences of `step` to
 /// `tolerance` relative to the Jacobian's scale (absolute below 1).
 inline void expectJacobiansMatchNumerical(const Factor& factor, const Values& values,
-                                          double tolerance = 1e-5) {
+                                          double tolerance = 1e-5, double step = 1e-6) {
   const Linearization linear = factor.linearize(values);
   ASSERT_EQ(linear.jacobians.size(), factor.keys().size());
   for (std::size_t i = 0; i < factor.keys().size(); ++i) {
     const Key key = factor.keys()[i];
-    const Eigen::MatrixXd numerical = numericalJacobian(factor, values, key);
+    const Eigen::MatrixXd numerical = numericalJacobian(factor, values, key, step);
     const double scale = std::max(1.0, numerical.cwiseAbs().maxCoeff());
     EXPECT_LE((linear.jacobians[i] - numerical).cwiseAbs().maxCoeff(), tolerance * scale)
         << factor.typeName() << " w.r.t. " << key << "\nanalytic:\n"

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -268,12 +269,36 @@ TEST(Pipeline, ReconstructsTheSameSceneInAnyUnit) {
 }
 
 // The hybrid graph: plane points seen at their true projections (0.3 px noise), given 2 mm off,
-// refined with the curves. Exact point observations must bring the poses closer to the truth
-// than the curves alone, and the points must move.
+// refined with the curves. The point factors must be minimised (the refined points fit their
+// sightings at the refined poses to about the pixel noise, where the given ones at the start are
+// pixels off), and the poses must end clearly closer to the truth than the drifting start and
+// than with the curves alone. A
+// better 3D point map is not expected: over five frames of a short arc the points' depth is no
+// better determined than the 2 mm they are given with.
 struct HybridRun {
   PipelineResult result;
+  double start_ate = 0.0;
   double ate = 0.0;
+  double given_reprojection_rms = 0.0;    ///< Given points at the initial poses (px).
+  double refined_reprojection_rms = 0.0;  ///< Refined points at the refined poses (px).
 };
+
+using Sightings = std::vector<std::vector<PointSighting>>;  // Per frame.
+
+double reprojectionRms(const Camera& camera, const std::vector<Pose3>& cam_from_world,
+                       const std::vector<Eigen::Vector3d>& points, const Sightings& sightings) {
+  double sum = 0.0;
+  int count = 0;
+  for (std::size_t f = 0; f < sightings.size(); ++f) {
+    for (const PointSighting& sighting : sightings[f]) {
+      Eigen::Vector2d pixel;
+      if (!camera.project(cam_from_world[f] * points[sighting.point], &pixel)) return 1e9;
+      sum += (pixel - sighting.pixel).squaredNorm();
+      ++count;
+    }
+  }
+  return std::sqrt(sum / std::max(count, 1));
+}
 
 HybridRun runFiveFramesWithPoints(bool hybrid) {
   const PlanarScene scene = fiveFrameOrbit();
@@ -292,23 +317,32 @@ HybridRun runFiveFramesWithPoints(bool hybrid) {
     given.push_back(p + Eigen::Vector3d(point_noise(rng), point_noise(rng), point_noise(rng)));
   }
   pipeline.setPoints(given);
+  Sightings sightings(scene.images.size());
   for (std::size_t f = 0; f < scene.images.size(); ++f) {
-    std::vector<PointSighting> sightings;
     for (std::size_t p = 0; p < points.size(); ++p) {
       Eigen::Vector2d pixel;
       if (!scene.camera->project(scene.true_cam_from_world[f] * points[p], &pixel) ||
           !scene.camera->isInImage(pixel)) {
         continue;
       }
-      sightings.push_back(
+      sightings[f].push_back(
           {static_cast<int>(p), pixel + Eigen::Vector2d(pixel_noise(rng), pixel_noise(rng))});
     }
     pipeline.addFrame(
-        {scene.timestamps[f], scene.images[f], scene.initial_cam_from_world[f], sightings});
+        {scene.timestamps[f], scene.images[f], scene.initial_cam_from_world[f], sightings[f]});
   }
-  HybridRun run{pipeline.finish(), 0.0};
+  HybridRun run{pipeline.finish()};
+  run.start_ate =
+      evaluateTrajectory(scene.true_cam_from_world, scene.initial_cam_from_world).position_ate_sim3;
   run.ate = evaluateTrajectory(scene.true_cam_from_world, run.result.keyframe_cam_from_world)
                 .position_ate_sim3;
+  run.given_reprojection_rms =
+      reprojectionRms(*scene.camera, scene.initial_cam_from_world, given, sightings);
+  if (run.result.points.size() == points.size() &&
+      run.result.keyframe_cam_from_world.size() == scene.images.size()) {
+    run.refined_reprojection_rms = reprojectionRms(
+        *scene.camera, run.result.keyframe_cam_from_world, run.result.points, sightings);
+  }
   return run;
 }
 
@@ -318,7 +352,11 @@ TEST(Pipeline, HybridGraphRefinesPointsBesideTheCurves) {
   ASSERT_EQ(hybrid.result.keyframe_cam_from_world.size(), 5u);
   EXPECT_TRUE(curves.result.points.empty());
   ASSERT_EQ(hybrid.result.points.size(), 80u);
-  EXPECT_LT(hybrid.ate, curves.ate) << "curves " << curves.ate;
+  EXPECT_LT(hybrid.refined_reprojection_rms, 1.0);
+  EXPECT_GT(hybrid.given_reprojection_rms, 3.0 * hybrid.refined_reprojection_rms);
+  EXPECT_LT(hybrid.ate, 0.6 * hybrid.start_ate) << "curves alone " << curves.ate;
+  // By 4 % on this scene: a change of local BA's solver alone has flipped it.
+  EXPECT_LT(hybrid.ate, curves.ate);
 }
 
 // The diagnosis of issue 14: curves lifted and registered at the true poses, the run's start the

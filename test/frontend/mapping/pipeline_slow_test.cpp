@@ -272,9 +272,8 @@ TEST(Pipeline, ReconstructsTheSameSceneInAnyUnit) {
 // refined with the curves. The point factors must be minimised (the refined points fit their
 // sightings at the refined poses to about the pixel noise, where the given ones at the start are
 // pixels off), and the poses must end clearly closer to the truth than the drifting start and
-// than with the curves alone. A
-// better 3D point map is not expected: over five frames of a short arc the points' depth is no
-// better determined than the 2 mm they are given with.
+// than with the curves alone. A better 3D point map is not expected: over five frames of a short
+// arc the points' depth is no better determined than the 2 mm they are given with.
 struct HybridRun {
   PipelineResult result;
   double start_ate = 0.0;

@@ -91,8 +91,10 @@ struct OptimizerOptions {
   /// each point) alone with our own dense Levenberg-Marquardt (graph/component_solver.h) instead
   /// of one Ceres solve over all of them, whose single trust region rejects every curve's step
   /// when one curve overshoots. Same objective and tolerances; max_iterations then counts per
-  /// component. Off by default: the pipeline's local BA is 3x faster with it, but the planar
-  /// bench ends 10 % worse on average (docs/benchmarks.md, "Structure-only solves").
+  /// component. Off by default: the pipeline's local BA is 3x faster with it, but each curve run
+  /// to its own tolerance ends on the favourable side of the nearest-edge residual's jumps, and
+  /// the first global BA then finds no step that lowers the cost (docs/benchmarks.md,
+  /// "Structure-only solves").
   bool solve_components_apart = false;
   /// Ceres inner iterations (a non-linear refinement of each step per independent block set).
   bool use_inner_iterations = false;

@@ -98,6 +98,11 @@ void CurveBundleAdjustmentOptions::validate() const {
           "must be in [1, " + std::to_string(CurveReprojectionFactor::kMaxSamples - 1) + "]");
   require(max_normal_angle_deg > 0.0 && max_normal_angle_deg <= 90.0, "max_normal_angle_deg",
           max_normal_angle_deg, "must be in (0, 90]");
+  require.nonNegative("interpolate_max_line_offset_px", interpolate_max_line_offset_px);
+  require.nonNegative("border_margin_px", border_margin_px);
+  require(interpolate_max_normal_angle_deg >= 0.0 && interpolate_max_normal_angle_deg <= 90.0,
+          "interpolate_max_normal_angle_deg", interpolate_max_normal_angle_deg,
+          "must be in [0, 90]");
   require.positive("pixel_sigma", pixel_sigma);
   require.positive("kernel_width", kernel_width);
   require.nonNegative("lambda1", lambda1);
@@ -123,9 +128,11 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
     addRegularisers(static_cast<std::uint32_t>(c), input.curves[c], options, &problem.graph);
   }
 
+  const EdgeBlending blending{options.interpolate_edges, options.interpolate_max_line_offset_px,
+                              options.interpolate_max_normal_angle_deg};
   const auto sampling = std::make_shared<const CurveSampling>(
       options.samples_per_segment + 1, options.use_subpixel_edges, options.max_normal_angle_deg,
-      options.interpolate_edges);
+      blending, options.border_margin_px);
   const NoiseModel pixel_noise{options.pixel_sigma,
                                RobustKernel(options.kernel, options.kernel_width)};
   const int num_curves = static_cast<int>(input.curves.size());

@@ -36,8 +36,17 @@ struct CurveBundleAdjustmentOptions {
   double max_normal_angle_deg = 90.0;
   /// Blend the residuals to the nearest edges of the four pixel centres around each sample, so
   /// that the residual does not jump as a sample crosses a pixel boundary
-  /// (CurveSampling::interpolate_edges).
+  /// (CurveSampling::blending).
   bool interpolate_edges = false;
+  /// The blend treats two edge pixels as one edge if each lies within this distance (px) of the
+  /// other's line (EdgeBlending); >= 0.
+  double interpolate_max_line_offset_px = 0.5;
+  /// ...and their normals are within this angle (deg), either sign; [0, 90].
+  double interpolate_max_normal_angle_deg = 45.0;
+  /// Measure a sample that projects outside the image but within this distance (px) of it
+  /// against the edge line at the closest image pixel, instead of capping it
+  /// (CurveSampling::border_margin_px); >= 0, 0 caps.
+  double border_margin_px = 0.0;
   double pixel_sigma = 1.0;                            ///< Std dev of an edge residual (px); > 0.
   RobustKernelType kernel = RobustKernelType::kHuber;  ///< Kernel on edge residuals.
   double kernel_width = 2.0;  ///< Kernel width in sigmas (px at sigma 1); > 0.

@@ -1,5 +1,6 @@
 #include "factors/curve_reprojection_factor.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -31,18 +32,28 @@ BezierSegmentParams segmentParams(const Eigen::Vector3d& q0, const Eigen::Vector
 }  // namespace
 
 CurveSampling::CurveSampling(int num_samples, bool use_subpixel_edges, double max_normal_angle_deg,
-                             bool interpolate_edges)
+                             const EdgeBlending& blending, double border_margin_px)
     : point_weights(4, num_samples),
       tangent_weights(4, num_samples),
       use_subpixel_edges(use_subpixel_edges),
       max_normal_angle_deg(max_normal_angle_deg),
       sin_max_normal_angle(std::sin(max_normal_angle_deg * M_PI / 180.0)),
-      interpolate_edges(interpolate_edges) {
+      blending(blending),
+      border_margin_px(border_margin_px),
+      blend_min_normal_cosine(std::cos(blending.max_normal_angle_deg * M_PI / 180.0)) {
   CURVESFM_CHECK(num_samples >= 2 && num_samples <= CurveReprojectionFactor::kMaxSamples)
       << "CurveSampling: " << num_samples << " samples, expected 2.."
       << CurveReprojectionFactor::kMaxSamples;
   CURVESFM_CHECK(max_normal_angle_deg > 0.0 && max_normal_angle_deg <= 90.0)
       << "CurveSampling: max_normal_angle_deg " << max_normal_angle_deg << ", expected (0, 90]";
+  CURVESFM_CHECK(blending.max_line_offset_px >= 0.0)
+      << "CurveSampling: blending.max_line_offset_px " << blending.max_line_offset_px
+      << ", expected >= 0";
+  CURVESFM_CHECK(blending.max_normal_angle_deg >= 0.0 && blending.max_normal_angle_deg <= 90.0)
+      << "CurveSampling: blending.max_normal_angle_deg " << blending.max_normal_angle_deg
+      << ", expected [0, 90]";
+  CURVESFM_CHECK(border_margin_px >= 0.0)
+      << "CurveSampling: border_margin_px " << border_margin_px << ", expected >= 0";
   point_weights = uniformBernsteinWeights(num_samples);
   for (int k = 0; k < num_samples; ++k) {
     const double t = static_cast<double>(k) / (num_samples - 1);
@@ -91,10 +102,9 @@ Eigen::Vector2d CurveReprojectionFactor::edgePosition(const EdgePixel& edge) con
 void CurveReprojectionFactor::measureSample(const Eigen::Vector2d& pixel, const EdgePixel& nearest,
                                             double* residual, Eigen::Vector2d* gradient) const {
   const Eigen::Vector2d normal = nearest.normal.cast<double>();
-  const Eigen::Vector2d position = edgePosition(nearest);
-  *residual = (pixel - position).dot(normal);
+  *residual = (pixel - edgePosition(nearest)).dot(normal);
   *gradient = normal;
-  if (!sampling_->interpolate_edges) return;
+  if (!sampling_->blending.enabled) return;
 
   // Corners (x0, y0), (x0 + 1, y0), (x0, y0 + 1), (x0 + 1, y0 + 1): pixel centres at integers.
   const double x0 = std::floor(pixel.x()), y0 = std::floor(pixel.y());
@@ -106,33 +116,71 @@ void CurveReprojectionFactor::measureSample(const Eigen::Vector2d& pixel, const 
   const std::array<Eigen::Vector2d, 4> d_weight = {
       Eigen::Vector2d(-(1 - fy), -(1 - fx)), Eigen::Vector2d(1 - fy, -fx),
       Eigen::Vector2d(-fy, 1 - fx), Eigen::Vector2d(fy, fx)};
-  // Only corners whose edge continues the nearest one's line join the blend; the others count
-  // with the nearest edge's residual. Blending the signed distances to two different edges
-  // would make a false zero between them.
-  const double nearest_residual = *residual;
-  *residual = 0.0;
-  gradient->setZero();
+
+  // The corners split into groups that lie on one edge; the blend runs over the heaviest group
+  // with its weights renormalised. A group keeps its members however the sample moves within
+  // the cell, so the blend changes continuously; it jumps only where another group becomes the
+  // heavier, which is where the sample's nearest edge becomes another edge anyway. Blending
+  // across groups would make a false zero between two edges.
+  std::array<unsigned, 4> group{};  // Bit j of group[i]: corners i and j lie on one edge.
   for (int i = 0; i < 4; ++i) {
-    double r = nearest_residual;
-    Eigen::Vector2d n = normal;
-    if (corner[i] && continuesEdge(*corner[i], position, normal)) {
-      n = corner[i]->normal.cast<double>();
-      if (n.dot(normal) < 0.0) n = -n;
-      r = (pixel - edgePosition(*corner[i])).dot(n);
+    if (!corner[i]) continue;
+    group[i] |= 1u << i;
+    for (int j = i + 1; j < 4; ++j) {
+      if (corner[j] && (corner[j] == corner[i] || sameEdge(*corner[i], *corner[j]))) {
+        group[i] |= 1u << j;
+        group[j] |= 1u << i;
+      }
     }
-    *residual += weight[i] * r;
-    *gradient += weight[i] * n + r * d_weight[i];
   }
+  int anchor = -1;
+  double anchor_weight = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    double w = 0.0;
+    for (int j = 0; j < 4; ++j) {
+      if (group[i] & (1u << j)) w += weight[j];
+    }
+    if (group[i] && w > anchor_weight) {
+      anchor = i;
+      anchor_weight = w;
+    }
+  }
+  if (anchor < 0) return;  // No corner within reach: the nearest edge alone.
+  const Eigen::Vector2d anchor_normal = corner[anchor]->normal.cast<double>();
+  double blended = 0.0, total = 0.0;
+  Eigen::Vector2d d_blended = Eigen::Vector2d::Zero(), d_total = Eigen::Vector2d::Zero();
+  for (int i = 0; i < 4; ++i) {
+    if (!(group[anchor] & (1u << i))) continue;
+    // One sign for the group: a normal's sign is the contrast's, not the edge's.
+    Eigen::Vector2d n = corner[i]->normal.cast<double>();
+    if (n.dot(anchor_normal) < 0.0) n = -n;
+    const double r = (pixel - edgePosition(*corner[i])).dot(n);
+    blended += weight[i] * r;
+    d_blended += weight[i] * n + r * d_weight[i];
+    total += weight[i];
+    d_total += d_weight[i];
+  }
+  // total >= the largest corner weight >= 1/4.
+  *residual = blended / total;
+  *gradient = (d_blended - *residual * d_total) / total;
 }
 
-bool CurveReprojectionFactor::continuesEdge(const EdgePixel& edge, const Eigen::Vector2d& position,
-                                            const Eigen::Vector2d& normal) const {
-  // Within kMaxLineOffsetPx of the nearest edge's line, and at most 45 deg off its normal either
-  // way (the sign of a normal is the contrast's, not the edge's).
-  constexpr double kMaxLineOffsetPx = 0.5;
-  constexpr double kMinNormalCosine = 0.7071;
-  return std::abs((edgePosition(edge) - position).dot(normal)) <= kMaxLineOffsetPx &&
-         std::abs(edge.normal.cast<double>().dot(normal)) >= kMinNormalCosine;
+const EdgePixel* CurveReprojectionFactor::nearestPastBorder(const Eigen::Vector2d& pixel) const {
+  const double margin = sampling_->border_margin_px;
+  const double right = field_->width() - 1.0, bottom = field_->height() - 1.0;
+  const double x = std::clamp(pixel.x(), 0.0, right), y = std::clamp(pixel.y(), 0.0, bottom);
+  if (margin <= 0.0 || (pixel - Eigen::Vector2d(x, y)).norm() > margin) return nullptr;
+  return field_->nearest(x, y);
+}
+
+bool CurveReprojectionFactor::sameEdge(const EdgePixel& a, const EdgePixel& b) const {
+  // Each within max_line_offset_px of the other's line, normals within max_normal_angle_deg
+  // either way; symmetric, so the groups do not depend on which corner asks.
+  const Eigen::Vector2d na = a.normal.cast<double>(), nb = b.normal.cast<double>();
+  const Eigen::Vector2d offset = edgePosition(b) - edgePosition(a);
+  const double max_offset = sampling_->blending.max_line_offset_px;
+  return std::abs(offset.dot(na)) <= max_offset && std::abs(offset.dot(nb)) <= max_offset &&
+         std::abs(na.dot(nb)) >= sampling_->blend_min_normal_cosine;
 }
 
 void CurveReprojectionFactor::locateSamples(const Pose3& cam_from_world, const Eigen::Matrix3d& R,
@@ -161,9 +209,15 @@ void CurveReprojectionFactor::locateSamples(const Pose3& cam_from_world, const E
   }
   for (int k = 0; k < num_samples; ++k) {
     if (b.outcome[k] != SampleOutcome::kOnField) continue;
+    if (!b.edge[k] && !field_->contains(b.pixel[k][0], b.pixel[k][1])) {
+      b.edge[k] = nearestPastBorder(b.pixel[k]);
+      if (!b.edge[k]) {
+        b.outcome[k] = SampleOutcome::kOutsideImage;
+        continue;
+      }
+    }
     if (!b.edge[k]) {
-      b.outcome[k] = field_->contains(b.pixel[k][0], b.pixel[k][1]) ? SampleOutcome::kBeyondReach
-                                                                    : SampleOutcome::kOutsideImage;
+      b.outcome[k] = SampleOutcome::kBeyondReach;
       continue;
     }
     if (check_orientation) checkOrientation(k, R, segment, &b);

@@ -16,7 +16,7 @@ namespace curvesfm {
 struct CurveSampleCounts {
   int on_field = 0;           ///< Projected within the field's reach of an edge: a live residual.
   int behind_camera = 0;      ///< Depth <= Camera::kMinDepth: capped.
-  int outside_image = 0;      ///< Projected outside the image: capped.
+  int outside_image = 0;      ///< Outside the image, beyond the border margin: capped.
   int beyond_reach = 0;       ///< Inside the image but farther than R from every edge: capped.
   int wrong_orientation = 0;  ///< Nearest edge not normal to the curve there: capped.
 
@@ -25,13 +25,25 @@ struct CurveSampleCounts {
   CurveSampleCounts& operator+=(const CurveSampleCounts& other);
 };
 
+/// Whether and what CurveReprojectionFactor blends over the four pixel centres around a sample
+/// (CurveSampling::blending).
+struct EdgeBlending {
+  bool enabled = false;
+  /// Two corners' edge pixels lie on one edge if each lies within this distance (px) of the
+  /// other's line...
+  double max_line_offset_px = 0.5;
+  /// ...and their normals are within this angle (deg), either sign.
+  double max_normal_angle_deg = 45.0;
+};
+
 /// How CurveReprojectionFactors sample their segment and which edge matches they accept. Built
 /// once and shared by every factor that samples alike.
 struct CurveSampling {
   /// `num_samples` = s + 1 samples at t_k = k / s (uniformBernsteinWeights), 2 <= s + 1 <=
-  /// CurveReprojectionFactor::kMaxSamples; 0 < max_normal_angle_deg <= 90. Throws CheckError.
+  /// CurveReprojectionFactor::kMaxSamples; 0 < max_normal_angle_deg <= 90; a blend's
+  /// max_line_offset_px >= 0 and its max_normal_angle_deg in [0, 90]. Throws CheckError.
   CurveSampling(int num_samples, bool use_subpixel_edges, double max_normal_angle_deg = 90.0,
-                bool interpolate_edges = false);
+                const EdgeBlending& blending = {}, double border_margin_px = 0.0);
 
   int numSamples() const { return static_cast<int>(point_weights.cols()); }
 
@@ -46,15 +58,23 @@ struct CurveSampling {
   /// 90 accepts every match.
   double max_normal_angle_deg = 90.0;
   double sin_max_normal_angle = 1.0;  ///< sin(max_normal_angle_deg), for the inner loop.
-  /// Blend the residuals to the nearest edges of the four pixel centres around the sample,
-  /// bilinearly, instead of using the one nearest pixel's edge. The nearest edge pixel changes
-  /// as a sample crosses a pixel boundary, and with it the residual jumps by up to a fraction of
-  /// a pixel: a solver that converges tightly parks samples on the favourable side of such
-  /// jumps, and then every step of a later joint solve looks worse. Blended, the residual is
-  /// continuous along an edge. Only corners whose edge continues the sample's nearest edge
-  /// blend: the signed distances to two edges a pixel apart would blend to a false zero between
-  /// them. Where the nearest edge itself changes to another edge the residual still jumps.
-  bool interpolate_edges = false;
+  /// With blending.enabled, blend the residuals to the nearest edges of the four pixel centres
+  /// around the sample, bilinearly, instead of using the one nearest pixel's edge. The nearest
+  /// edge pixel changes as a sample crosses a pixel boundary, and with it the residual jumps by
+  /// up to a fraction of a pixel: a solver that converges tightly parks samples on the
+  /// favourable side of such jumps, and then every step of a later joint solve looks worse.
+  /// Blended, the residual is continuous along an edge. The four corners' edge pixels split into
+  /// groups on one edge (EdgeBlending's line offset and angle) and only the heaviest group
+  /// blends, its weights renormalised: the signed distances to two edges a pixel apart would
+  /// blend to a false zero between them. Where another group becomes the heavier, which is
+  /// where the nearest edge itself becomes another edge, the residual still jumps.
+  EdgeBlending blending;
+  /// A sample that projects outside the image, but within this distance (px) of it, is measured
+  /// against the nearest edge of the closest image pixel, extending that edge's line past the
+  /// border, instead of taking the capped residual: a sample of a curve that leaves the image
+  /// then does not jump from a small residual to the cap as it crosses the border. 0: capped.
+  double border_margin_px = 0.0;
+  double blend_min_normal_cosine = 0.0;  ///< cos(blending.max_normal_angle_deg).
 };
 
 /// The geometric term E_geo of one (segment, keyframe) pair (paper §3.1, eq. 6): samples
@@ -64,12 +84,13 @@ struct CurveSampling {
 /// sub-pixel position, or its pixel centre if `use_subpixel_edges` is off) and g the unit image
 /// gradient there. eta and g are constant within one evaluation: the residual measures distance
 /// across the edge only, so a sample may slide along it, which is what keeps a partly observed
-/// curve unbiased. With CurveSampling::interpolate_edges the residual is the bilinear blend of
-/// the residuals to the nearest edges of the four pixel centres around x_k, where those continue
-/// the line of the sample's own nearest edge (else its residual stands in), and its Jacobian
-/// includes the weights' derivatives.
+/// curve unbiased. With CurveSampling::blending the residual is the bilinear blend of
+/// the residuals to the nearest edges of the four pixel centres around x_k that lie on one edge
+/// (the heaviest such group, weights renormalised), and its Jacobian includes the weights'
+/// derivatives.
 ///
-/// A sample that projects behind the camera, outside the image, farther than the field's reach R
+/// A sample that projects behind the camera, outside the image (farther than
+/// CurveSampling::border_margin_px from it), farther than the field's reach R
 /// from every edge, or onto an edge of the wrong orientation (CurveSampling::max_normal_angle_deg)
 /// gets the capped residual R (px) with zero Jacobians: it costs what the worst live sample
 /// could, never pulls, and never produces NaN. sampleCounts() counts them.
@@ -122,14 +143,16 @@ class CurveReprojectionFactor
   void checkOrientation(int k, const Eigen::Matrix3d& R, const SegmentEvaluator& segment,
                         SampleBatch* batch) const;
   /// The residual of a sample at `pixel` whose nearest edge pixel is `nearest`, and its
-  /// derivative with respect to the pixel (CurveSampling::interpolate_edges).
+  /// derivative with respect to the pixel (CurveSampling::blending).
   void measureSample(const Eigen::Vector2d& pixel, const EdgePixel& nearest, double* residual,
                      Eigen::Vector2d* gradient) const;
   Eigen::Vector2d edgePosition(const EdgePixel& edge) const;
-  /// Whether `edge` lies on the line of the edge at `position` with unit `normal` (a neighbour
-  /// pixel of the same edge), so that their residuals may be blended.
-  bool continuesEdge(const EdgePixel& edge, const Eigen::Vector2d& position,
-                     const Eigen::Vector2d& normal) const;
+  /// For a sample outside the image: the nearest edge of the closest image pixel if the sample
+  /// lies within CurveSampling::border_margin_px of the image, else null.
+  const EdgePixel* nearestPastBorder(const Eigen::Vector2d& pixel) const;
+  /// Whether two edge pixels lie on one edge (each on the other's line, normals alike), so that
+  /// their residuals may be blended.
+  bool sameEdge(const EdgePixel& a, const EdgePixel& b) const;
 
   std::shared_ptr<const NearestEdgeField> field_;
   std::shared_ptr<const Camera> camera_;

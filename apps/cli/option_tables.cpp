@@ -290,6 +290,16 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
       .boolean("interpolate_edges", "interpolate-edges", &b->interpolate_edges,
                "Blend the residuals to the nearest edges of the four pixel centres around a "
                "sample, so that it does not jump between pixels")
+      .number("interpolate_max_line_offset_px", "interpolate-max-line-offset",
+              &b->interpolate_max_line_offset_px,
+              "Blend: two edge pixels are one edge if each lies within this distance of the "
+              "other's line (px)")
+      .number("interpolate_max_normal_angle_deg", "interpolate-max-normal-angle",
+              &b->interpolate_max_normal_angle_deg,
+              "Blend: ...and their normals are within this angle (deg)")
+      .number("border_margin_px", "border-margin", &b->border_margin_px,
+              "Measure samples up to this far outside the image against the edge line at the "
+              "border instead of capping them (px; 0: capped)")
       .number("pixel_sigma", "pixel-sigma", &b->pixel_sigma, "Std dev of an edge residual (px)")
       .enumeration("kernel", "kernel", &b->kernel, "Robust kernel on edge residuals")
       .number("kernel_width", "kernel-width", &b->kernel_width, "Kernel width (sigmas)")

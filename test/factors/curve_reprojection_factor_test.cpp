@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -99,7 +100,7 @@ CurveReprojectionFactor makeFactor(std::shared_ptr<const NearestEdgeField> field
   return CurveReprojectionFactor(
       poseKey(0), kSegment, std::move(field), std::move(camera),
       std::make_shared<const CurveSampling>(num_samples, subpixel, max_normal_angle_deg,
-                                            interpolate_edges),
+                                            EdgeBlending{interpolate_edges}),
       NoiseModel{});
 }
 
@@ -176,10 +177,8 @@ TEST(CurveReprojectionFactor, InterpolatedJacobiansMatchNumericalAtRandomConfigu
 // The edges of a bright disc of radius 100 px about (520, 240), rendered anti-aliased and
 // blurred a little, through Sobel and Canny as the frontend does: a curved edge, whose pixels'
 // normals and sub-pixel positions change from one edge pixel to the next.
-std::shared_ptr<const NearestEdgeField> discEdgeField() {
-  cv::Mat image(kHeight, kWidth, CV_8UC1, cv::Scalar(40));
-  cv::circle(image, cv::Point(520 * 16, 240 * 16), 100 * 16, cv::Scalar(200), cv::FILLED,
-             cv::LINE_AA, 4);
+// The field of an 8-bit grey image's Canny edges after a light blur.
+std::shared_ptr<const NearestEdgeField> cannyEdgeField(cv::Mat image) {
   cv::GaussianBlur(image, image, cv::Size(5, 5), 1.0);
   cv::Mat grad_x, grad_y, edges;
   cv::Sobel(image, grad_x, CV_32F, 1, 0);
@@ -187,6 +186,13 @@ std::shared_ptr<const NearestEdgeField> discEdgeField() {
   cv::Canny(image, edges, 50, 100);
   return std::make_shared<const NearestEdgeField>(
       NearestEdgeField::build(edges, grad_x, grad_y, NearestEdgeFieldOptions{}));
+}
+
+std::shared_ptr<const NearestEdgeField> discEdgeField() {
+  cv::Mat image(kHeight, kWidth, CV_8UC1, cv::Scalar(40));
+  cv::circle(image, cv::Point(520 * 16, 240 * 16), 100 * 16, cv::Scalar(200), cv::FILLED,
+             cv::LINE_AA, 4);
+  return cannyEdgeField(image);
 }
 
 // The largest change of any sample's residual between consecutive positions of a segment slid
@@ -213,6 +219,91 @@ TEST(CurveReprojectionFactor, InterpolatedResidualDoesNotJumpAtPixelBoundaries) 
   const double nearest = largestResidualStep(false), blended = largestResidualStep(true);
   EXPECT_GT(nearest, 0.02);
   EXPECT_LT(blended, 0.0125);
+}
+
+// Canny edges of a photograph at 640x480: curved, broken and close edges, where the four pixel
+// centres around a sample often belong to different edges.
+std::shared_ptr<const NearestEdgeField> photographEdgeField(const std::string& path) {
+  cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) return nullptr;
+  cv::resize(image, image, cv::Size(kWidth, kHeight), 0.0, 0.0, cv::INTER_AREA);
+  return cannyEdgeField(image);
+}
+
+// How many samples' residuals change by more than 0.01 px when vertical segments across the
+// image move sideways by 0.002 px over a pixel's midline or a pixel boundary (where the nearest
+// edge pixel, or the four blended ones, change), counting samples within 3 px of an edge.
+int residualJumpsAcrossPixelBoundaries(std::shared_ptr<const NearestEdgeField> field,
+                                       bool interpolate_edges) {
+  const auto factor =
+      makeFactor(std::move(field), pinholeCamera(), 11, true, 90.0, interpolate_edges);
+  const double metres_per_px = 2.0 / 500.0;  // At 2 m depth.
+  int jumps = 0;
+  for (double top = -0.45; top < 0.0; top += 0.09) {
+    for (int column = 40; column < kWidth - 40; ++column) {
+      for (double boundary : {0.5, 1.0}) {
+        const double x = (column + boundary - 0.001 - 320.0) * metres_per_px;
+        Values before = straightSegment(x), after = straightSegment(x + 0.002 * metres_per_px);
+        for (Values* values : {&before, &after}) {
+          const double shifted_x = values->at<Eigen::Vector3d>(kSegment.q0).x();
+          values->update(kSegment.q0, Eigen::Vector3d(shifted_x, top, 2.0));
+          values->update(kSegment.q1, Eigen::Vector3d(shifted_x, top + 0.4, 2.0));
+        }
+        const Eigen::VectorXd r0 = factor.unwhitenedError(before);
+        const Eigen::VectorXd r1 = factor.unwhitenedError(after);
+        for (int k = 0; k < r0.size(); ++k) {
+          if (std::abs(r0[k]) < 3.0 && std::abs(r1[k]) < 3.0 && std::abs(r1[k] - r0[k]) > 0.01)
+            ++jumps;
+        }
+      }
+    }
+  }
+  return jumps;
+}
+
+TEST(CurveReprojectionFactor, InterpolatedResidualJumpsRarelyOnAPhotographsEdges) {
+  // The blend jumps only where the heaviest group of corners on one edge changes to another
+  // edge; the nearest edge pixel's residual at most pixel crossings near curved edges.
+  const std::string photograph = "/usr/share/doc/opencv-doc/examples/data/graf1.png";
+  const auto field = photographEdgeField(photograph);
+  if (!field) GTEST_SKIP() << photograph << " not installed (opencv-doc)";
+  const int nearest = residualJumpsAcrossPixelBoundaries(field, false);
+  const int blended = residualJumpsAcrossPixelBoundaries(field, true);
+  EXPECT_GT(nearest, 5000);         // 9,433 of about 61,600 moves.
+  EXPECT_LT(blended, nearest / 4);  // 1,384.
+}
+
+// A vertical segment on the edge at column 420 that runs past the image's bottom row (rows
+// 340-540 at 2 m depth), `offset_px` to the right of the edge.
+Values segmentPastTheBottom(double offset_px) {
+  Values values = straightSegment(0.4 + offset_px * 2.0 / 500.0);
+  const double x = values.at<Eigen::Vector3d>(kSegment.q0).x();
+  values.update(kSegment.q0, Eigen::Vector3d(x, 0.4, 2.0));
+  values.update(kSegment.q1, Eigen::Vector3d(x, 1.2, 2.0));
+  return values;
+}
+
+CurveReprojectionFactor borderFactor(double border_margin_px) {
+  return CurveReprojectionFactor(
+      poseKey(0), kSegment, verticalEdgeField(420), pinholeCamera(),
+      std::make_shared<const CurveSampling>(11, true, 90.0, EdgeBlending{}, border_margin_px),
+      NoiseModel{});
+}
+
+TEST(CurveReprojectionFactor, SamplesPastTheBorderFollowTheEdgeLineWithinTheMargin) {
+  const Values values = segmentPastTheBottom(0.3);
+  // Rows 340 + 20 k: samples 7-10 (rows 480-540) lie outside the 480-row image.
+  const CurveReprojectionFactor capped = borderFactor(0.0);
+  EXPECT_EQ(capped.sampleCounts(values).outside_image, 4);
+  EXPECT_DOUBLE_EQ(capped.unwhitenedError(values)[8], capped.cappedResidual());
+
+  // A 40 px margin measures rows up to 519 against the edge line: the same 0.3 px as inside.
+  const CurveReprojectionFactor extended = borderFactor(40.0);
+  EXPECT_EQ(extended.sampleCounts(values).outside_image, 2);
+  const Eigen::VectorXd error = extended.unwhitenedError(values);
+  for (int k = 0; k <= 8; ++k) EXPECT_NEAR(error[k], 0.3, 1e-6) << "sample " << k;
+  EXPECT_DOUBLE_EQ(error[9], extended.cappedResidual());
+  testing::expectJacobiansMatchNumerical(extended, values, 1e-5);
 }
 
 TEST(CurveReprojectionFactor, JacobiansMatchNumericalOnAStraightEdge) {
@@ -338,6 +429,8 @@ TEST(CurveReprojectionFactor, RejectsMissingInputsAndBadSampling) {
   EXPECT_THROW(CurveSampling(1, true), CheckError);
   EXPECT_THROW(CurveSampling(11, true, 0.0), CheckError);
   EXPECT_THROW(CurveSampling(11, true, 91.0), CheckError);
+  EXPECT_THROW(CurveSampling(11, true, 90.0, EdgeBlending{true, -0.1, 45.0}), CheckError);
+  EXPECT_THROW(CurveSampling(11, true, 90.0, EdgeBlending{true, 0.5, 91.0}), CheckError);
 }
 
 TEST(CurveReprojectionFactor, OrientationCheckCapsSamplesOnEdgesAlongTheCurve) {

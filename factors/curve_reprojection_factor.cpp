@@ -120,8 +120,8 @@ void CurveReprojectionFactor::measureSample(const Eigen::Vector2d& pixel, const 
   // The corners split into groups that lie on one edge; the blend runs over the heaviest group
   // with its weights renormalised. A group keeps its members however the sample moves within
   // the cell, so the blend changes continuously; it jumps only where another group becomes the
-  // heavier, which is where the sample's nearest edge becomes another edge anyway. Blending
-  // across groups would make a false zero between two edges.
+  // heavier, near where the sample's nearest edge becomes another edge anyway. Blending across
+  // groups would make a false zero between two edges.
   std::array<unsigned, 4> group{};  // Bit j of group[i]: corners i and j lie on one edge.
   for (int i = 0; i < 4; ++i) {
     if (!corner[i]) continue;
@@ -145,7 +145,8 @@ void CurveReprojectionFactor::measureSample(const Eigen::Vector2d& pixel, const 
       anchor_weight = w;
     }
   }
-  if (anchor < 0) return;  // No corner within reach: the nearest edge alone.
+  // No corner in the image and within reach (a sample past the border): the nearest edge alone.
+  if (anchor < 0) return;
   const Eigen::Vector2d anchor_normal = corner[anchor]->normal.cast<double>();
   double blended = 0.0, total = 0.0;
   Eigen::Vector2d d_blended = Eigen::Vector2d::Zero(), d_total = Eigen::Vector2d::Zero();

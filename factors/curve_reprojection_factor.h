@@ -66,8 +66,8 @@ struct CurveSampling {
   /// Blended, the residual is continuous along an edge. The four corners' edge pixels split into
   /// groups on one edge (EdgeBlending's line offset and angle) and only the heaviest group
   /// blends, its weights renormalised: the signed distances to two edges a pixel apart would
-  /// blend to a false zero between them. Where another group becomes the heavier, which is
-  /// where the nearest edge itself becomes another edge, the residual still jumps.
+  /// blend to a false zero between them. Where another group becomes the heavier, near where
+  /// the nearest edge itself becomes another edge, the residual still jumps.
   EdgeBlending blending;
   /// A sample that projects outside the image, but within this distance (px) of it, is measured
   /// against the nearest edge of the closest image pixel, extending that edge's line past the

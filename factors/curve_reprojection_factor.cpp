@@ -168,9 +168,10 @@ void CurveReprojectionFactor::measureSample(const Eigen::Vector2d& pixel, const 
 
 const EdgePixel* CurveReprojectionFactor::nearestPastBorder(const Eigen::Vector2d& pixel) const {
   const double margin = sampling_->border_margin_px;
+  if (margin <= 0.0) return nullptr;
   const double right = field_->width() - 1.0, bottom = field_->height() - 1.0;
   const double x = std::clamp(pixel.x(), 0.0, right), y = std::clamp(pixel.y(), 0.0, bottom);
-  if (margin <= 0.0 || (pixel - Eigen::Vector2d(x, y)).norm() > margin) return nullptr;
+  if ((pixel - Eigen::Vector2d(x, y)).norm() > margin) return nullptr;
   return field_->nearest(x, y);
 }
 

@@ -105,6 +105,15 @@ TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
   options.lambda1 = -1.0;
   expectRejected(options, "lambda1");
   options = {};
+  options.interpolate_max_line_offset_px = -0.1;
+  expectRejected(options, "interpolate_max_line_offset_px");
+  options = {};
+  options.interpolate_max_normal_angle_deg = 91.0;
+  expectRejected(options, "interpolate_max_normal_angle_deg");
+  options = {};
+  options.border_margin_px = -1.0;
+  expectRejected(options, "border_margin_px");
+  options = {};
   options.max_normal_angle_deg = 0.0;
   expectRejected(options, "max_normal_angle_deg");
   options.max_normal_angle_deg = 120.0;

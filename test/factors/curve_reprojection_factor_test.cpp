@@ -431,6 +431,7 @@ TEST(CurveReprojectionFactor, RejectsMissingInputsAndBadSampling) {
   EXPECT_THROW(CurveSampling(11, true, 91.0), CheckError);
   EXPECT_THROW(CurveSampling(11, true, 90.0, EdgeBlending{true, -0.1, 45.0}), CheckError);
   EXPECT_THROW(CurveSampling(11, true, 90.0, EdgeBlending{true, 0.5, 91.0}), CheckError);
+  EXPECT_THROW(CurveSampling(11, true, 90.0, EdgeBlending{}, -1.0), CheckError);
 }
 
 TEST(CurveReprojectionFactor, OrientationCheckCapsSamplesOnEdgesAlongTheCurve) {

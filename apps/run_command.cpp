@@ -416,9 +416,11 @@ void printSummary(const RunInput& input, const PipelineResult& r, double seconds
   }
   for (std::size_t i = 0; i < r.reassociation.size(); ++i) {
     const ScheduleReport& ba = r.reassociation[i].global_ba;
-    std::printf("re-association %zu: %d observations added, global BA cost %.6g -> %.6g, %.2f s\n",
-                i + 1, r.reassociation[i].added_observations, ba.initial_cost, ba.final_cost,
-                ba.total_seconds);
+    std::printf(
+        "re-association %zu: %d observations added (%d segments left to other curves), global BA "
+        "cost %.6g -> %.6g, %.2f s\n",
+        i + 1, r.reassociation[i].added_observations, r.reassociation[i].left_to_other_curves,
+        ba.initial_cost, ba.final_cost, ba.total_seconds);
   }
   std::printf(
       "samples: %d on field, %d behind camera, %d outside image, %d beyond reach, %d wrong "
@@ -434,6 +436,7 @@ nlohmann::json reassociationToJson(const std::vector<ReassociationRound>& rounds
   nlohmann::json json = nlohmann::json::array();
   for (const ReassociationRound& round : rounds) {
     json.push_back({{"added_observations", round.added_observations},
+                    {"left_to_other_curves", round.left_to_other_curves},
                     {"global_ba", scheduleReportToJson(round.global_ba)}});
   }
   return json;

@@ -397,6 +397,12 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
       .boolean("reassociation_skip_explained", "reassociation-skip-explained",
                &o->reassociation_skip_explained,
                "Re-association leaves edges that curves observed in a keyframe already explain")
+      .boolean("reassociation_skip_occluded", "reassociation-skip-occluded",
+               &o->reassociation_skip_occluded,
+               "Re-association leaves segments hidden behind a nearer curve observed in a keyframe")
+      .number("reassociation_occluder_depth_ratio", "reassociation-occluder-depth-ratio",
+              &o->reassociation_occluder_depth_ratio,
+              "A curve hides a sample where its depth is below this fraction of the sample's")
       .number("reassociation_max_edge_distance_px", "reassociation-max-edge-distance",
               &o->reassociation_max_edge_distance_px,
               "Largest mean edge distance of a re-associated segment (px; 0: "

@@ -14,6 +14,7 @@
 #include "factors/point_bundle_adjustment.h"
 #include "factors/pose_variables.h"
 #include "frontend/mapping/keyframe_selector.h"
+#include "frontend/mapping/nearest_curve_depths.h"
 
 namespace curvesfm {
 namespace {
@@ -56,18 +57,25 @@ ObservedSegmentAppearance registration(int id, int segment, int keyframe,
   return {{id, segment, keyframe}, verdict.appearance, verdict.viewing_direction_in_world};
 }
 
-// The projection of a segment as a polyline, or empty if part of it is behind the camera.
+// The projection of a segment as a polyline, or empty if part of it is behind the camera; with
+// `depths`, also each vertex's depth (z in the camera).
 std::vector<cv::Point> projectSegment(const BezierSegmentParams& segment,
                                       const Pose3& cam_from_world, const Camera& camera,
-                                      int samples) {
+                                      int samples, std::vector<double>* depths = nullptr) {
   const CubicBezier cubic = segment.toCubic();
   std::vector<cv::Point> polyline;
+  if (depths) depths->clear();
   for (int k = 0; k < samples; ++k) {
     Eigen::Vector2d pixel;
     const double t = static_cast<double>(k) / (samples - 1);
-    if (!camera.project(cam_from_world * cubic.evaluate(t), &pixel)) return {};
+    const Eigen::Vector3d in_camera = cam_from_world * cubic.evaluate(t);
+    if (!camera.project(in_camera, &pixel)) {
+      if (depths) depths->clear();
+      return {};
+    }
     polyline.emplace_back(static_cast<int>(std::lround(pixel.x())),
                           static_cast<int>(std::lround(pixel.y())));
+    if (depths) depths->push_back(in_camera.z());
   }
   return polyline;
 }
@@ -246,6 +254,9 @@ void PipelineOptions::validate() const {
       reassociation_max_viewing_angle_deg >= 0.0 && reassociation_max_viewing_angle_deg <= 180.0,
       "reassociation_max_viewing_angle_deg", reassociation_max_viewing_angle_deg,
       "must be in [0, 180]");
+  require(reassociation_occluder_depth_ratio > 0.0 && reassociation_occluder_depth_ratio <= 1.0,
+          "reassociation_occluder_depth_ratio", reassociation_occluder_depth_ratio,
+          "must be in (0, 1]");
   require(std::isfinite(explained_radius_px) && explained_radius_px >= 0.0, "explained_radius_px",
           explained_radius_px, "must be finite and >= 0");
 }
@@ -270,18 +281,26 @@ struct Pipeline::Impl {
   void trackPose(Keyframe* keyframe);
   /// One attempt to register segment i of curve `id` in keyframe k (see tryRegister).
   struct SegmentAttempt {
-    bool explained_elsewhere = false;  ///< Skipped: most of it lies on already explained edges.
+    /// Skipped: most of it lies on already explained edges, or behind a nearer curve.
+    bool explained_elsewhere = false;
     CorrespondenceVerdict verdict;
     std::vector<cv::Point> polyline;  ///< Its projection into keyframe k.
+    std::vector<double> depths;       ///< Its vertices' depths in keyframe k.
   };
   SegmentAttempt tryRegister(int k, const KeyframeView& view, int id, int i,
-                             const CorrespondenceOptions& checks, const cv::Mat* explained);
+                             const CorrespondenceOptions& checks, const cv::Mat* explained,
+                             const NearestCurveDepths* occluders = nullptr);
   void registerTier(int k, CurveState state, bool skip_explained, cv::Mat* explained,
                     KeyframeStats* stats);
   void registerMap(int k, cv::Mat* explained, KeyframeStats* stats);
-  int reassociate();
-  int reassociateIn(int k, const std::vector<int>& ids, const CorrespondenceOptions& checks);
+  void reassociate(ReassociationRound* round);
+  void reassociateIn(int k, const std::vector<int>& ids, const CorrespondenceOptions& checks,
+                     ReassociationRound* round);
+  /// Calls draw(polyline, depths) for the projection of every segment observed in keyframe k.
+  template <typename Draw>
+  void forEachObservedProjection(int k, Draw draw) const;
   cv::Mat explainedEdges(int k) const;
+  NearestCurveDepths nearestCurveDepths(int k) const;
   /// Samples along a segment's projection when it is matched against explained edges.
   int projectionSamples() const { return 2 * options.correspondence.samples_per_segment + 1; }
   /// Width (px) of the band a registered segment explains around its projection.
@@ -418,13 +437,15 @@ void Pipeline::Impl::trackPose(Keyframe* keyframe) {
 Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const KeyframeView& view, int id,
                                                            int i,
                                                            const CorrespondenceOptions& checks,
-                                                           const cv::Mat* explained) {
+                                                           const cv::Mat* explained,
+                                                           const NearestCurveDepths* occluders) {
   const MapCurve& curve = map.curve(id);
   const BezierSegmentParams segment = curve.curve.segment(i);
   SegmentAttempt attempt;
-  attempt.polyline =
-      projectSegment(segment, keyframes[k].cam_from_world, *camera, projectionSamples());
-  if (explained && fractionOnMask(attempt.polyline, *explained) > 0.5) {
+  attempt.polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera,
+                                    projectionSamples(), &attempt.depths);
+  if ((explained && fractionOnMask(attempt.polyline, *explained) > 0.5) ||
+      (occluders && occluders->fractionOccluded(attempt.polyline, attempt.depths) > 0.5)) {
     attempt.explained_elsewhere = true;
     return attempt;
   }
@@ -465,8 +486,8 @@ void Pipeline::Impl::registerMap(int k, cv::Mat* explained, KeyframeStats* stats
 
 // Registers every promoted curve's segments in every keyframe that does not observe them yet,
 // with the same four checks (tightened by the reassociation_* options), at the refined poses and
-// curves. Returns the observations added.
-int Pipeline::Impl::reassociate() {
+// curves; counts what it added and what it left to other curves in `round`.
+void Pipeline::Impl::reassociate(ReassociationRound* round) {
   std::vector<int> ids = map.curvesIn(CurveState::kGlobal);
   for (const int id : map.curvesIn(CurveState::kDisabled)) {
     if (map.curve(id).promoted) ids.push_back(id);
@@ -478,54 +499,77 @@ int Pipeline::Impl::reassociate() {
   if (options.reassociation_max_viewing_angle_deg > 0.0) {
     checks.max_viewing_angle_deg = options.reassociation_max_viewing_angle_deg;
   }
-  int added = 0;
   for (int k = 0; k < static_cast<int>(keyframes.size()); ++k) {
-    added += reassociateIn(k, ids, checks);
+    reassociateIn(k, ids, checks, round);
   }
-  return added;
 }
 
 // Re-association in keyframe k of the segments of curves `ids` it does not observe yet.
-int Pipeline::Impl::reassociateIn(int k, const std::vector<int>& ids,
-                                  const CorrespondenceOptions& checks) {
+void Pipeline::Impl::reassociateIn(int k, const std::vector<int>& ids,
+                                   const CorrespondenceOptions& checks, ReassociationRound* round) {
   const KeyframeView view = viewOf(keyframes[k], *camera);
   cv::Mat explained;
   if (options.reassociation_skip_explained) explained = explainedEdges(k);
-  int added = 0;
+  std::optional<NearestCurveDepths> occluders;
+  if (options.reassociation_skip_occluded) occluders = nearestCurveDepths(k);
   for (const int id : ids) {
     for (int i = 0; i < map.curve(id).curve.numSegments(); ++i) {
       if (map.curve(id).segments[i].observedIn(k)) continue;
       const SegmentAttempt attempt =
-          tryRegister(k, view, id, i, checks, explained.empty() ? nullptr : &explained);
+          tryRegister(k, view, id, i, checks, explained.empty() ? nullptr : &explained,
+                      occluders ? &*occluders : nullptr);
+      round->left_to_other_curves += attempt.explained_elsewhere;
       if (!attempt.verdict.registered) continue;
-      if (!explained.empty() && !attempt.polyline.empty()) {
+      ++round->added_observations;
+      if (attempt.polyline.empty()) continue;
+      if (!explained.empty()) {
         cv::polylines(explained, std::vector<std::vector<cv::Point>>{attempt.polyline}, false,
                       cv::Scalar(255), explainedThickness());
       }
-      ++added;
+      if (occluders) occluders->add(attempt.polyline, attempt.depths);
     }
   }
-  return added;
 }
 
-// The pixels of keyframe k that the segments observed there explain: their projections at the
-// current poses and curves, drawn explainedThickness() px wide. Curves the sanity checks dropped
-// explain nothing.
-cv::Mat Pipeline::Impl::explainedEdges(int k) const {
-  cv::Mat explained = cv::Mat::zeros(camera->height(), camera->width(), CV_8UC1);
-  std::vector<std::vector<cv::Point>> polylines;
+template <typename Draw>
+void Pipeline::Impl::forEachObservedProjection(int k, Draw draw) const {
+  std::vector<double> depths;
   for (int id = 0; id < map.size(); ++id) {
     const MapCurve& curve = map.curve(id);
+    // Curves the sanity checks dropped explain nothing.
     if (curve.state == CurveState::kImplausible) continue;
     for (int i = 0; i < curve.curve.numSegments(); ++i) {
       if (!curve.segments[i].observedIn(k)) continue;
-      std::vector<cv::Point> polyline = projectSegment(
-          curve.curve.segment(i), keyframes[k].cam_from_world, *camera, projectionSamples());
-      if (!polyline.empty()) polylines.push_back(std::move(polyline));
+      std::vector<cv::Point> polyline =
+          projectSegment(curve.curve.segment(i), keyframes[k].cam_from_world, *camera,
+                         projectionSamples(), &depths);
+      if (!polyline.empty()) draw(std::move(polyline), depths);
     }
   }
+}
+
+// The pixels of keyframe k that the segments observed there explain: their projections at the
+// current poses and curves, drawn explainedThickness() px wide.
+cv::Mat Pipeline::Impl::explainedEdges(int k) const {
+  cv::Mat explained = cv::Mat::zeros(camera->height(), camera->width(), CV_8UC1);
+  std::vector<std::vector<cv::Point>> polylines;
+  forEachObservedProjection(k, [&](std::vector<cv::Point> polyline, const std::vector<double>&) {
+    polylines.push_back(std::move(polyline));
+  });
   cv::polylines(explained, polylines, false, cv::Scalar(255), explainedThickness());
   return explained;
+}
+
+// The depth of the nearest segment observed in keyframe k around each pixel, over the band
+// explainedEdges() draws.
+NearestCurveDepths Pipeline::Impl::nearestCurveDepths(int k) const {
+  NearestCurveDepths nearest(camera->width(), camera->height(), explainedThickness() / 2,
+                             options.reassociation_occluder_depth_ratio);
+  forEachObservedProjection(
+      k, [&](const std::vector<cv::Point>& polyline, const std::vector<double>& depths) {
+        nearest.add(polyline, depths);
+      });
+  return nearest;
 }
 
 // The keyframe poses now, in the unit of the poses given; a pose nothing moved is returned
@@ -903,7 +947,7 @@ PipelineResult Pipeline::finish() {
       if (drop) impl.checkCurves(true);
       checked_since_ba = drop;
       ReassociationRound round;
-      round.added_observations = impl.reassociate();
+      impl.reassociate(&round);
       if (round.added_observations == 0) break;
       checked_since_ba = false;
       round.global_ba = impl.bundleAdjust(CurveSelection::kPromoted, impl.options.global_ba,

@@ -110,14 +110,28 @@ struct PipelineOptions {
   /// Re-association leaves a keyframe's edges to the curves already observed there: a segment
   /// whose projection lies mostly (over half its samples) within explained_radius_px of the
   /// projection of a segment observed in that keyframe is not registered there, nor are two
-  /// re-associated segments on one edge. A segment hidden behind another curve's surface then
-  /// cannot take that curve's edge. Off by default: on real scenes it lowered the drift of a
-  /// start at the truth (Pavilion 4.41 -> 3.47 mm), but on the planar bench, where the curve a
+  /// re-associated segments on one edge. Off by default: on real scenes it lowered the drift of
+  /// a start at the truth (Pavilion 4.41 -> 3.47 mm; 4.87 -> 3.99 on session 16's code, where
+  /// blocking only nearer curves gave 4.71: what it blocks there is mostly curves at their own
+  /// depth, not hidden ones), but on the planar bench, where the curve a
   /// re-associated segment would meet is mostly its own duplicate, started after the segment's
   /// curve was lost, it kept tracks short and 5 of 6 cases ended 20-50 % worse (LinuxLogo 1.53
-  /// -> 2.31 mm; docs/benchmarks.md). Telling an occluder (nearer) from a duplicate (as near)
-  /// is the next step.
+  /// -> 2.31 mm; docs/benchmarks.md). reassociation_skip_occluded tells an occluder (nearer)
+  /// from a duplicate (as near).
   bool reassociation_skip_explained = false;
+  /// Re-association leaves a segment hidden behind a nearer curve: one whose projection lies
+  /// mostly (over half its samples) within explained_radius_px of the projection of a segment
+  /// observed in that keyframe, or re-associated there before it, whose depth at that pixel is
+  /// below reassociation_occluder_depth_ratio times the sample's own. Unlike
+  /// reassociation_skip_explained it lets a curve take an edge that a duplicate at its own depth
+  /// explains, so on a plane it blocks little (the demo: 45 segments a round, ATE 0.343 -> 0.341
+  /// mm). Off by default: on the real sets its results stay within the noise seeds' spread
+  /// (docs/benchmarks.md, session 16).
+  bool reassociation_skip_occluded = false;
+  /// A curve occludes a sample where its depth is below this fraction of the sample's depth
+  /// (unitless, in (0, 1]): the margin keeps two curves on one surface, whose depths differ by
+  /// their lifting errors, from hiding each other.
+  double reassociation_occluder_depth_ratio = 0.9;
   /// Largest mean edge distance of a re-associated segment (px; see
   /// CorrespondenceOptions::max_mean_edge_distance_px); 0 takes correspondence's.
   double reassociation_max_edge_distance_px = 0.0;
@@ -236,6 +250,9 @@ KeyframeTimes keyframeTimes(const std::vector<KeyframeStats>& frames);
 /// One round of re-association after global BA (PipelineOptions::reassociation_rounds).
 struct ReassociationRound {
   int added_observations = 0;  ///< (segment, keyframe) registrations the round added.
+  /// Segments left to curves already observed in a keyframe, unchecked: on their explained
+  /// edges (reassociation_skip_explained) or behind them (reassociation_skip_occluded).
+  int left_to_other_curves = 0;
   ScheduleReport global_ba;    ///< The global BA that followed.
 };
 

@@ -75,6 +75,7 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   ASSERT_TRUE(report["reassociation"].is_array());
   for (const auto& round : report["reassociation"]) {
     EXPECT_GT(round["added_observations"].get<int>(), 0);
+    EXPECT_EQ(round["left_to_other_curves"].get<int>(), 0);  // Both checks are off by default.
     EXPECT_TRUE(round["global_ba"].contains("rounds"));
   }
   EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));

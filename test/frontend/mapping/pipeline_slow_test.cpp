@@ -387,27 +387,35 @@ TEST(Pipeline, FrontendPosesShapeTheMapNotTheStart) {
   }
 }
 
-// One re-association round on the five frames of the small orbit: observations it added.
-int observationsReassociated(bool skip_explained) {
+// One re-association round on the five frames of the small orbit.
+ReassociationRound reassociationRound(bool skip_explained, bool skip_occluded) {
   const PlanarScene scene = fiveFrameOrbit();
   PipelineOptions options;
   options.reassociation_rounds = 1;
   options.reassociation_skip_explained = skip_explained;
+  options.reassociation_skip_occluded = skip_occluded;
   Pipeline pipeline(*scene.camera, options);
   for (std::size_t i = 0; i < scene.images.size(); ++i) {
     pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
   }
   const PipelineResult result = pipeline.finish();
-  return result.reassociation.empty() ? -1 : result.reassociation[0].added_observations;
+  if (result.reassociation.empty()) return {-1, -1, {}};
+  return result.reassociation[0];
 }
 
 // Without the check, re-association lets a curve take edges that another curve observed in that
 // keyframe already explains (duplicates on a plane; a hidden curve on an occluder's edge in 3D).
-TEST(Pipeline, ReassociationLeavesExplainedEdgesToTheirCurves) {
-  const int with_check = observationsReassociated(true);
-  const int without_check = observationsReassociated(false);
-  EXPECT_GE(with_check, 0);
-  EXPECT_LT(with_check, without_check);
+// On a plane no curve hides another, so the occlusion check leaves every segment to the checks.
+TEST(Pipeline, ReassociationLeavesExplainedEdgesToTheirCurvesAndOnAPlaneNothingIsHidden) {
+  const ReassociationRound with_check = reassociationRound(true, false);
+  const ReassociationRound without_check = reassociationRound(false, false);
+  const ReassociationRound occlusion_check = reassociationRound(false, true);
+  EXPECT_GE(with_check.added_observations, 0);
+  EXPECT_LT(with_check.added_observations, without_check.added_observations);
+  EXPECT_GT(with_check.left_to_other_curves, 0);
+  EXPECT_EQ(without_check.left_to_other_curves, 0);
+  EXPECT_EQ(occlusion_check.left_to_other_curves, 0);
+  EXPECT_EQ(occlusion_check.added_observations, without_check.added_observations);
 }
 
 // The small orbit started at its true poses, with or without an upright cylinder at the plane's

@@ -33,6 +33,13 @@ TEST(PipelineOptions, ValidateChecksTheReassociationGates) {
   EXPECT_THAT([&] { options.validate(); },
               testing::ThrowsMessage<InvalidOptions>(
                   testing::HasSubstr("PipelineOptions.reassociation_max_viewing_angle_deg")));
+  for (const double ratio : {0.0, 1.5}) {
+    options = {};
+    options.reassociation_occluder_depth_ratio = ratio;
+    EXPECT_THAT([&] { options.validate(); },
+                testing::ThrowsMessage<InvalidOptions>(
+                    testing::HasSubstr("PipelineOptions.reassociation_occluder_depth_ratio")));
+  }
   EXPECT_FALSE(PipelineOptions{}.reassociation_skip_explained);
 }
 

@@ -39,10 +39,11 @@ struct CurveBundleAdjustmentOptions {
   /// (CurveSampling::blending).
   bool interpolate_edges = false;
   /// The blend treats two edge pixels as one edge if each lies within this distance (px) of the
-  /// other's line (EdgeBlending); >= 0.
-  double interpolate_max_line_offset_px = 0.5;
-  /// ...and their normals are within this angle (deg), either sign; [0, 90].
-  double interpolate_max_normal_angle_deg = 45.0;
+  /// other's line; >= 0. Flat rather than an EdgeBlending member, so that the options table
+  /// names each field; the defaults are EdgeBlending's (0.5 px).
+  double interpolate_max_line_offset_px = EdgeBlending{}.max_line_offset_px;
+  /// ...and their normals are within this angle (deg), either sign; [0, 90] (45 deg).
+  double interpolate_max_normal_angle_deg = EdgeBlending{}.max_normal_angle_deg;
   /// Measure a sample that projects outside the image but within this distance (px) of it
   /// against the edge line at the closest image pixel, instead of capping it
   /// (CurveSampling::border_margin_px); >= 0, 0 caps.

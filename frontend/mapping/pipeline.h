@@ -112,8 +112,8 @@ struct PipelineOptions {
   /// projection of a segment observed in that keyframe is not registered there, nor are two
   /// re-associated segments on one edge. Off by default: on real scenes it lowered the drift of
   /// a start at the truth (Pavilion 4.41 -> 3.47 mm; 4.87 -> 3.99 on session 16's code, where
-  /// blocking only nearer curves gave 4.71: what it blocks there is mostly curves at their own
-  /// depth, not hidden ones), but on the planar bench, where the curve a
+  /// blocking only nearer curves gave 4.71 and a random third of the re-associations 3.84: it
+  /// helps by adding fewer, not by choosing), but on the planar bench, where the curve a
   /// re-associated segment would meet is mostly its own duplicate, started after the segment's
   /// curve was lost, it kept tracks short and 5 of 6 cases ended 20-50 % worse (LinuxLogo 1.53
   /// -> 2.31 mm; docs/benchmarks.md). reassociation_skip_occluded tells an occluder (nearer)

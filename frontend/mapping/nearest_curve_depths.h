@@ -16,7 +16,7 @@ class NearestCurveDepths {
   NearestCurveDepths(int width, int height, int half_width, double occluder_depth_ratio);
 
   /// Adds a projected curve: pixel vertices with their depths, linear in between. Pieces are
-  /// clipped to the image, so a projection that runs far outside costs nothing there.
+  /// clipped to the image and its band, so a projection that runs far outside costs nothing there.
   void add(const std::vector<cv::Point>& polyline, const std::vector<double>& depths);
 
   /// Fraction of the vertices that lie behind a curve nearer than the ratio times their own depth

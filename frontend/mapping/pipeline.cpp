@@ -285,7 +285,7 @@ struct Pipeline::Impl {
     bool explained_elsewhere = false;
     CorrespondenceVerdict verdict;
     std::vector<cv::Point> polyline;  ///< Its projection into keyframe k.
-    std::vector<double> depths;       ///< Its vertices' depths in keyframe k.
+    std::vector<double> depths;       ///< Its vertices' depths, with the occlusion check.
   };
   SegmentAttempt tryRegister(int k, const KeyframeView& view, int id, int i,
                              const CorrespondenceOptions& checks, const cv::Mat* explained,
@@ -442,8 +442,10 @@ Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const Keyframe
   const MapCurve& curve = map.curve(id);
   const BezierSegmentParams segment = curve.curve.segment(i);
   SegmentAttempt attempt;
+  // Depths only for the occlusion check: the incremental registration tries every curve in
+  // every keyframe and has no use for them.
   attempt.polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera,
-                                    projectionSamples(), &attempt.depths);
+                                    projectionSamples(), occluders ? &attempt.depths : nullptr);
   if ((explained && fractionOnMask(attempt.polyline, *explained) > 0.5) ||
       (occluders && occluders->fractionOccluded(attempt.polyline, attempt.depths) > 0.5)) {
     attempt.explained_elsewhere = true;

@@ -220,6 +220,7 @@ CurveBundleAdjustmentOptions defaultPipelineBundleAdjustmentOptions() {
   CurveBundleAdjustmentOptions options;
   options.lambda1 = 0.018;
   options.scale_sigma = 7.4e-3;
+  options.kernel = RobustKernelType::kCauchy;
   return options;
 }
 

@@ -50,7 +50,14 @@ CorrespondenceOptions defaultPipelineCorrespondenceOptions();
 /// min_keyframe_translation 0.74 (was 0.01 m).
 CurveMapOptions defaultPipelineMapOptions();
 /// lambda1 0.018 px^2 per squared scene scale (was 100 px^2/m^2), scale_sigma 7.4e-3 scene scales
-/// (was 1e-4 m).
+/// (was 1e-4 m), and a Cauchy kernel (width 2) on the edge residuals instead of Huber's: it
+/// redescends, so a sample within the field's reach of a neighbouring edge pulls less the
+/// farther it lies, where Huber's pull stays constant. Re-association adds many such samples in
+/// views far from those that lifted a curve: started at the truth, Pavilion drifts 3.08 mm
+/// instead of 4.87 and templeRing 0.38 instead of 0.84. The pipeline's starts are a few pixels
+/// off at most; a start far off loses some basin (Pavilion from the point initialiser, 41 mm
+/// off: 0.74 x instead of 0.66 x), and the factor layer's synthetic protocol (2 cm / 1 deg, tens
+/// of pixels) keeps Huber (docs/benchmarks.md, "A redescending kernel", session 17).
 CurveBundleAdjustmentOptions defaultPipelineBundleAdjustmentOptions();
 
 /// Every tunable of the incremental pipeline (paper §2.3, §3.3-3.4), one struct per stage.
@@ -124,9 +131,9 @@ struct PipelineOptions {
   /// observed in that keyframe, or re-associated there before it, whose depth at that pixel is
   /// below reassociation_occluder_depth_ratio times the sample's own. Unlike
   /// reassociation_skip_explained it lets a curve take an edge that a duplicate at its own depth
-  /// explains, so on a plane it blocks little (the demo: 45 segments a round, ATE 0.343 -> 0.341
-  /// mm). Off by default: on the real sets its results stay within the noise seeds' spread
-  /// (docs/benchmarks.md, session 16).
+  /// explains, so on a plane it blocks little (the demo under session 16's Huber kernel: 45
+  /// segments a round, ATE 0.343 -> 0.341 mm). Off by default: on the real sets its results stay
+  /// within the noise seeds' spread (docs/benchmarks.md, session 16).
   bool reassociation_skip_occluded = false;
   /// A curve occludes a sample where its depth is below this fraction of the sample's depth
   /// (unitless, in (0, 1]): the margin keeps two curves on one surface, whose depths differ by

@@ -54,9 +54,9 @@ CurveMapOptions defaultPipelineMapOptions();
 /// redescends, so a sample within the field's reach of a neighbouring edge pulls less the
 /// farther it lies, where Huber's pull stays constant. Re-association adds many such samples in
 /// views far from those that lifted a curve: started at the truth, Pavilion drifts 3.08 mm
-/// instead of 4.87 and templeRing 0.38 instead of 0.84. The pipeline's starts are a few pixels
-/// off at most; a start far off loses some basin (Pavilion from the point initialiser, 41 mm
-/// off: 0.74 x instead of 0.66 x), and the factor layer's synthetic protocol (2 cm / 1 deg, tens
+/// instead of 4.87 and templeRing 0.38 instead of 0.84. A start far off loses some basin: from
+/// the point initialiser the kernels are even over six real sets (Pavilion, 41 mm off, 0.66 ->
+/// 0.74 x; KITTI 0.72 -> 0.68 x), and the factor layer's synthetic protocol (2 cm / 1 deg, tens
 /// of pixels) keeps Huber (docs/benchmarks.md, "A redescending kernel", session 17).
 CurveBundleAdjustmentOptions defaultPipelineBundleAdjustmentOptions();
 

@@ -59,7 +59,7 @@ using bench::Clock;
 struct BenchOptions {
   std::string out;     ///< Folder for scaling.csv (created); empty writes no file.
   bool quick = false;  ///< A tiny sweep (smoke test).
-  int threads = 1;     ///< Ceres threads (evaluation and linear algebra); >= 1.
+  int threads = 1;     ///< Solver threads (evaluation and linear algebra); >= 1.
   std::string linear_solver = "sparse_schur";  ///< OptimizerOptions::linear_solver by name.
   int iterations = 10;                         ///< LM iterations per solve; >= 1.
   int repeats = 3;               ///< Solves per configuration; the median is reported; >= 1.
@@ -73,6 +73,7 @@ struct BenchOptions {
   std::vector<int> segment_sweep;
   /// OptimizerOptions::curve_blocks: one solver block per curve (false: one per variable).
   bool curve_blocks = true;
+  bool verbose = false;  ///< Print each solve's log (Ceres' or graph_schur's time split).
 };
 
 struct Configuration {
@@ -254,6 +255,7 @@ SchedulerOptions fixedIterationSolve(const BenchOptions& options) {
   optimizer.max_iterations = options.iterations;
   optimizer.num_threads = options.threads;
   optimizer.curve_blocks = options.curve_blocks;
+  optimizer.verbose = options.verbose;
   optimizer.function_tolerance = 1e-300;
   optimizer.gradient_tolerance = 1e-300;
   optimizer.parameter_tolerance = 1e-300;
@@ -532,7 +534,7 @@ void printSettings(const BenchOptions& options) {
   std::printf(
       "# scaling_bench: images %dx%d, 360 deg orbit (r = 3 m) in a 12 x 3 x 12 m room, %d "
       "segments per curve, %d samples per observation; joint solves of %d LM iterations (median of "
-      "%d), %s, %d Ceres thread(s), %s; each configuration in its own process\n\n",
+      "%d), %s, %d solver thread(s), %s; each configuration in its own process\n\n",
       scene.intrinsics.width, scene.intrinsics.height, options.segments_per_curve,
       options.samples_per_segment + 1, options.iterations, options.repeats,
       options.linear_solver.c_str(), options.threads,
@@ -576,11 +578,13 @@ int main(int argc, char** argv) {
   CLI::App app{"Curve BA scaling: time per LM iteration and peak memory vs keyframes and segments"};
   app.add_option("--out", options.out, "Folder for scaling.csv (none if empty)");
   app.add_flag("--quick", options.quick, "A tiny sweep (smoke test)");
-  app.add_option("--threads", options.threads, "Ceres threads")
+  app.add_option("--threads", options.threads, "Solver threads")
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
-  app.add_option("--linear-solver", options.linear_solver,
-                 "sparse_schur, dense_schur, iterative_schur or sparse_normal_cholesky")
+  app.add_option(
+         "--linear-solver", options.linear_solver,
+         "sparse_schur, dense_schur, iterative_schur, sparse_normal_cholesky or graph_schur "
+         "(our own Schur complement)")
       ->capture_default_str();
   app.add_option("--iterations", options.iterations, "LM iterations per solve")
       ->check(CLI::Range(1, 1000))
@@ -610,6 +614,7 @@ int main(int argc, char** argv) {
   app.add_option("--segment-sweep", options.segment_sweep,
                  "Segment counts of the segment sweep (default 100 500 1000 2500 5000)")
       ->check(CLI::Range(1, 100000));
+  app.add_flag("--verbose", options.verbose, "Print each solve's log and time split");
   app.add_option("--curve-blocks", options.curve_blocks,
                  "One solver block per curve (false: one per variable, the old layout)")
       ->capture_default_str();

@@ -2,9 +2,9 @@
 // curve bundle adjustment, compared on a fixed set of synthetic curve scenes.
 //
 // Every combination of strategy {joint, alternating, inner_iterations} x linear solver
-// {sparse_schur, dense_schur, iterative_schur} x kernel {none, huber, cauchy} x (lambda1,
-// lambda2) in {0, 1e2, 1e4} x {0, 1, 10} runs on each scene from the same perturbed start.
-// Then the best configuration (lowest mean ATE over the scenes) runs again with integer edge
+// (--solvers; default {sparse_schur, dense_schur, iterative_schur}) x kernel {none, huber, cauchy}
+// x (lambda1, lambda2) in {0, 1e2, 1e4} x {0, 1, 10} runs on each scene from the same perturbed
+// start. Then the best configuration (lowest mean ATE over the scenes) runs again with integer edge
 // positions instead of sub-pixel ones.
 //
 // Writes into --out: runs.csv (one row per run), summary.md (tables), and through
@@ -113,6 +113,8 @@ struct BenchOptions {
   int max_iterations = 100;                ///< Ceres iterations per solve.
   bool curve_blocks = true;                ///< OptimizerOptions::curve_blocks.
   bool components_apart = false;           ///< OptimizerOptions::solve_components_apart.
+  /// Linear solvers swept, by OptimizerOptions::linear_solver name.
+  std::vector<std::string> solvers = {"sparse_schur", "dense_schur", "iterative_schur"};
 };
 
 Run solve(const PreparedScene& prepared, const Config& config, const BenchOptions& options) {
@@ -146,11 +148,10 @@ Run solve(const PreparedScene& prepared, const Config& config, const BenchOption
   return run;
 }
 
-std::vector<Config> sweepConfigs() {
+std::vector<Config> sweepConfigs(const std::vector<LinearSolver>& solvers) {
   std::vector<Config> configs;
   for (Strategy strategy : {Strategy::kJoint, Strategy::kAlternating, Strategy::kInnerIterations}) {
-    for (LinearSolver solver :
-         {LinearSolver::kSparseSchur, LinearSolver::kDenseSchur, LinearSolver::kIterativeSchur}) {
+    for (LinearSolver solver : solvers) {
       for (RobustKernelType kernel :
            {RobustKernelType::kNone, RobustKernelType::kHuber, RobustKernelType::kCauchy}) {
         for (double lambda1 : {0.0, 1e2, 1e4}) {
@@ -259,7 +260,11 @@ int run(const BenchOptions& options) {
   std::vector<PreparedScene> scenes;
   for (const NamedScene& scene : named) scenes.push_back(prepare(scene));
 
-  std::vector<Config> configs = sweepConfigs();
+  std::vector<LinearSolver> solvers;
+  for (const std::string& name : options.solvers) {
+    solvers.push_back(parseEnumName<LinearSolver>(name, "OptimizerOptions", "linear_solver"));
+  }
+  std::vector<Config> configs = sweepConfigs(solvers);
   if (options.quick) configs.resize(configs.size() / 9);
   std::vector<Run> runs;
   int done = 0;
@@ -327,6 +332,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--curve-blocks", options.curve_blocks,
                  "One solver block per curve (false: one per variable)")
+      ->capture_default_str();
+  app.add_option("--solvers", options.solvers,
+                 "Linear solvers swept (graph_schur: our own Schur complement)")
+      ->delimiter(',')
       ->capture_default_str();
   app.add_option("--components-apart", options.components_apart,
                  "With every pose held (alternating's structure step), solve each curve alone "

@@ -7,13 +7,14 @@
 #include "graph/ceres_problem.h"
 #include "graph/component_solver.h"
 #include "graph/optimizer.h"
+#include "graph/schur_solver.h"
 
 namespace curvesfm {
 namespace {
 
 bool isSchur(LinearSolver solver) {
   return solver == LinearSolver::kSparseSchur || solver == LinearSolver::kDenseSchur ||
-         solver == LinearSolver::kIterativeSchur;
+         solver == LinearSolver::kIterativeSchur || solver == LinearSolver::kGraphSchur;
 }
 
 // Hands every iteration of a solve to OptimizerOptions::on_iteration.
@@ -36,6 +37,12 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values, const Pro
   options.validate();
   if (options.solve_components_apart && !hasFreePose(graph, config)) {
     return optimizeComponents(graph, values, config, options);
+  }
+  std::string graph_schur_refused;
+  if (options.linear_solver == LinearSolver::kGraphSchur) {
+    std::optional<OptimizationSummary> summary =
+        optimizeWithGraphSchur(graph, values, config, options, &graph_schur_refused);
+    if (summary) return *summary;
   }
   const auto start = Clock::now();
   OptimizationSummary summary;
@@ -60,6 +67,9 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values, const Pro
   }
   if (options.use_inner_iterations) {
     ceres_options.inner_iteration_ordering = bridge.innerIterationOrdering();
+  }
+  if (!graph_schur_refused.empty()) {
+    summary.ordering += "; Ceres instead of graph_schur: " + graph_schur_refused;
   }
   summary.num_constant_variables = bridge.numConstant();
   summary.num_curve_blocks = bridge.numCurveBlocks();

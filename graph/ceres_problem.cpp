@@ -298,6 +298,7 @@ ceres::Solver::Options toCeresOptions(const OptimizerOptions& options) {
   ceres::Solver::Options ceres_options;
   switch (options.linear_solver) {
     case LinearSolver::kSparseSchur:
+    case LinearSolver::kGraphSchur:  // Beyond graph_schur's limits (graph/schur_solver.h).
       ceres_options.linear_solver_type = ceres::SPARSE_SCHUR;
       break;
     case LinearSolver::kDenseSchur:

@@ -12,16 +12,10 @@
 
 #include "core/clock.h"
 #include "core/union_find.h"
+#include "graph/levenberg_marquardt.h"
 
 namespace curvesfm {
 namespace {
-
-// Ceres' defaults for what OptimizerOptions does not expose.
-constexpr double kMinRelativeDecrease = 1e-3;
-constexpr double kMinDiagonal = 1e-6;
-constexpr double kMaxDiagonal = 1e32;
-constexpr double kMaxTrustRegionRadius = 1e16;
-constexpr double kMinTrustRegionRadius = 1e-32;
 
 // A variable some factor uses, with its place in the ambient buffer of all such variables.
 struct Slot {
@@ -231,18 +225,8 @@ class ComponentProblem {
       blocks_.push_back({column, tangent_offset_[keys[k].variable], dim});
       column += dim;
     }
-    r_ = Eigen::Map<const Eigen::VectorXd>(error_.data(), rows) / sigma;
-    const double sqrt_rho1 = std::sqrt(std::max(rho[1], 0.0));
-    if (s > 0.0 && rho[2] > 0.0 && rho[1] > 0.0) {
-      const double alpha = 1.0 - std::sqrt(std::max(1.0 + 2.0 * s * rho[2] / rho[1], 0.0));
-      rJ_.noalias() = r_.transpose() * J_;
-      J_.noalias() -= (alpha / s) * r_ * rJ_;
-      J_ *= sqrt_rho1 / sigma;
-      r_ *= sqrt_rho1 / (1.0 - alpha);
-    } else {
-      J_ *= sqrt_rho1 / sigma;
-      r_ *= sqrt_rho1;
-    }
+    r_ = Eigen::Map<const Eigen::VectorXd>(error_.data(), rows);
+    whitenAndCorrect(sigma, s, rho, &J_, &r_);
     // Products of a few dozen columns: lazy (coefficient-wise) products skip the blocked GEMM's
     // packing, which dominated this function's profile.
     JtJ_.noalias() = J_.transpose().lazyProduct(J_);
@@ -279,7 +263,6 @@ class ComponentProblem {
   int columns_ = 0;
   Eigen::MatrixXd J_;
   Eigen::VectorXd r_;
-  Eigen::RowVectorXd rJ_;
   Eigen::MatrixXd JtJ_;
   Eigen::VectorXd Jtr_;
   std::vector<Block> blocks_;
@@ -301,14 +284,13 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
   Eigen::MatrixXd H(n, n);
   Eigen::VectorXd g(n);
   double cost = problem->evaluate(*x, &H, &g);
-  double radius = options.initial_trust_region_radius;
-  double decrease_factor = 2.0;
+  TrustRegionRadius radius(options.initial_trust_region_radius);
   std::vector<double> candidate;
   result.converged = g.lpNorm<Eigen::Infinity>() <= options.gradient_tolerance;
   while (!result.converged && result.iterations < options.max_iterations) {
     ++result.iterations;
     Eigen::MatrixXd A = H;
-    A.diagonal() += H.diagonal().cwiseMax(kMinDiagonal).cwiseMin(kMaxDiagonal) / radius;
+    A.diagonal() += marquardtDiagonal(H.diagonal()) * radius.damping();
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(A);
     const Eigen::VectorXd step = -ldlt.solve(g);
     const bool solved = ldlt.info() == Eigen::Success && step.allFinite();
@@ -330,16 +312,13 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
       const double ratio = change / model_decrease;
       x->swap(candidate);
       cost = problem->evaluate(*x, &H, &g);
-      radius = std::min(kMaxTrustRegionRadius,
-                        radius / std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * ratio - 1.0, 3)));
-      decrease_factor = 2.0;
+      radius.accept(ratio);
       result.converged = change <= options.function_tolerance * cost ||
                          g.lpNorm<Eigen::Infinity>() <= options.gradient_tolerance;
     } else {
       ++result.rejected;
-      radius /= decrease_factor;
-      decrease_factor *= 2.0;
-      result.converged = radius < kMinTrustRegionRadius;
+      radius.reject();
+      result.converged = radius.collapsed();
     }
   }
   return result;

@@ -25,16 +25,23 @@ struct ProblemConfig {
   }
 };
 
-enum class LinearSolver { kSparseSchur, kDenseSchur, kIterativeSchur, kSparseNormalCholesky };
+enum class LinearSolver {
+  kSparseSchur,
+  kDenseSchur,
+  kIterativeSchur,
+  kSparseNormalCholesky,
+  kGraphSchur
+};
 enum class TrustRegion { kLevenbergMarquardt, kDogleg };
 
 template <>
 struct EnumNames<LinearSolver> {
-  static constexpr std::array<std::pair<LinearSolver, const char*>, 4> kNames = {{
+  static constexpr std::array<std::pair<LinearSolver, const char*>, 5> kNames = {{
       {LinearSolver::kSparseSchur, "sparse_schur"},
       {LinearSolver::kDenseSchur, "dense_schur"},
       {LinearSolver::kIterativeSchur, "iterative_schur"},
       {LinearSolver::kSparseNormalCholesky, "sparse_normal_cholesky"},
+      {LinearSolver::kGraphSchur, "graph_schur"},
   }};
 };
 template <>
@@ -58,7 +65,12 @@ struct OptimizerOptions {
   /// Linear solver of each step. Schur solvers eliminate structure (points, curve variables)
   /// first; iterative_schur uses the SCHUR_JACOBI preconditioner; sparse ones use SuiteSparse.
   /// A solve with every pose held (structure only) uses sparse_normal_cholesky whatever this
-  /// says: there is no reduced system, and the step is the same.
+  /// says: there is no reduced system, and the step is the same. graph_schur is not Ceres: our
+  /// own Levenberg-Marquardt with every curve and point eliminated by a dense Schur complement
+  /// and a dense reduced system over the poses (graph/schur_solver.h; same objective, damping
+  /// and stopping rules; the ordering and curve blocks do not apply). Beyond its size limits, and
+  /// with inner iterations or dogleg, it hands the problem to Ceres' sparse_schur and says so in
+  /// the summary's ordering.
   LinearSolver linear_solver = LinearSolver::kSparseSchur;
   TrustRegion trust_region = TrustRegion::kLevenbergMarquardt;  ///< Step strategy.
   int max_iterations = 50;                                      ///< Outer iterations; >= 0.

@@ -20,13 +20,15 @@ struct Solved {
 };
 
 Solved solve(const CurveScene& scene, Strategy strategy,
-             const CurveBundleAdjustmentOptions& ba = {}, bool curve_blocks = true) {
+             const CurveBundleAdjustmentOptions& ba = {}, bool curve_blocks = true,
+             LinearSolver solver = LinearSolver::kSparseSchur) {
   const CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
   CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
   SchedulerOptions scheduler;
   scheduler.strategy = strategy;
   scheduler.optimizer.max_iterations = 100;
   scheduler.optimizer.curve_blocks = curve_blocks;
+  scheduler.optimizer.linear_solver = solver;
   Solved solved;
   solved.before = evaluateCurveScene(scene, input.cam_from_world, input.curves);
   solved.report = runSchedule(problem.graph, &problem.values, problem.config, scheduler);
@@ -38,6 +40,15 @@ Solved solve(const CurveScene& scene, Strategy strategy,
 
 // The protocol: poses perturbed by ~2 cm / 1 deg, curves by ~2 cm, noise-free images.
 CurveSceneOptions perturbedScene() { return CurveSceneOptions{}; }
+
+// A small start error, so that two solvers' step sequences end in the same basin.
+CurveScene slightlyPerturbedScene() {
+  CurveSceneOptions options;
+  options.pose_noise_translation = 0.005;
+  options.pose_noise_rotation_deg = 0.2;
+  options.curve_point_noise = 0.005;
+  return makeCurveScene(options);
+}
 
 TEST(CurveBundleAdjustment, JointRecoversPosesAndCurvesFromAPerturbedStart) {
   const Solved solved = solve(makeCurveScene(perturbedScene()), Strategy::kJoint);
@@ -53,12 +64,7 @@ TEST(CurveBundleAdjustment, JointRecoversPosesAndCurvesFromAPerturbedStart) {
 }
 
 TEST(CurveBundleAdjustment, ABlockPerCurveReachesTheOptimumOfABlockPerVariable) {
-  // A small start error, so that both steps sequences end in the same basin.
-  CurveSceneOptions options;
-  options.pose_noise_translation = 0.005;
-  options.pose_noise_rotation_deg = 0.2;
-  options.curve_point_noise = 0.005;
-  const CurveScene scene = makeCurveScene(options);
+  const CurveScene scene = slightlyPerturbedScene();
   const Solved per_variable = solve(scene, Strategy::kJoint, {}, false);
   const Solved per_curve = solve(scene, Strategy::kJoint, {}, true);
   const OptimizationSummary& a = per_variable.report.rounds.front().summary;
@@ -71,6 +77,23 @@ TEST(CurveBundleAdjustment, ABlockPerCurveReachesTheOptimumOfABlockPerVariable) 
   EXPECT_NEAR(per_curve.after.position_ate_sim3, per_variable.after.position_ate_sim3, 2e-4);
   EXPECT_NEAR(per_curve.after.curve_mean_error_aligned, per_variable.after.curve_mean_error_aligned,
               5e-4);
+}
+
+TEST(CurveBundleAdjustment, OurOwnSchurComplementReachesTheOptimumOfCeres) {
+  const CurveScene scene = slightlyPerturbedScene();
+  const Solved ceres = solve(scene, Strategy::kJoint, {}, false);
+  const Solved ours = solve(scene, Strategy::kJoint, {}, true, LinearSolver::kGraphSchur);
+  const OptimizationSummary& a = ceres.report.rounds.front().summary;
+  const OptimizationSummary& b = ours.report.rounds.front().summary;
+  EXPECT_EQ(b.linear_solver, "GRAPH_SCHUR");
+  EXPECT_EQ(b.ordering,
+            "graph_schur (" + std::to_string(scene.true_curves.size()) + " groups eliminated, " +
+                std::to_string(scene.true_cam_from_world.size() - 1) + " poses reduced)");
+  EXPECT_NEAR(b.initial_cost, a.initial_cost, 1e-9 * a.initial_cost);
+  EXPECT_NEAR(b.final_cost, a.final_cost, 0.01 * a.final_cost);
+  EXPECT_NEAR(ours.after.position_ate_sim3, ceres.after.position_ate_sim3, 2e-4);
+  EXPECT_NEAR(ours.after.curve_mean_error_aligned, ceres.after.curve_mean_error_aligned, 5e-4);
+  EXPECT_LT(ours.after.position_ate_sim3, 0.5 * ours.before.position_ate_sim3);
 }
 
 TEST(CurveBundleAdjustment, AlternatingReachesTheCostOfJointAndImprovesAsMuch) {

@@ -2,57 +2,18 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
-
-#include "core/so3.h"
 #include "graph/optimizer.h"
-#include "test/graph/test_factors.h"
+#include "test/graph/toy_scene.h"
 
 namespace curvesfm {
 namespace {
 
-using testing::AllTypesFactor;
-using testing::PointPriorFactor;
-
 constexpr int kGroups = 6;
 constexpr int kPoses = 4;
 
-// kGroups independent structures (a point, a direction and a scale each) seen through the same
-// kPoses poses, with noisy targets so that the optimum keeps a cost, and a Huber prior on every
-// point so that the kernel's weights matter.
-struct Scene {
-  FactorGraph graph;
-  Values start;
-};
+using Scene = testing::ToyScene;
 
-Scene makeScene() {
-  std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0.0, 0.05);
-  Scene scene;
-  for (int i = 0; i < kPoses; ++i) {
-    scene.start.insert(poseKey(i), Pose3(so3::exp(Eigen::Vector3d(0.2 * i, -0.1, 0.3)),
-                                         Eigen::Vector3d(i, 0.5 * i, 1.0)));
-  }
-  const NoiseModel huber{0.1, RobustKernel(RobustKernelType::kHuber, 1.0)};
-  for (int g = 0; g < kGroups; ++g) {
-    const Eigen::Vector3d point(g, 1.0 - g, 2.0);
-    const Direction direction(Eigen::Vector3d(1.0, 0.2 * g, 0.5).normalized());
-    const double scale = 1.0 + 0.1 * g;
-    for (int i = 0; i < kPoses; ++i) {
-      const Pose3& pose = scene.start.at<Pose3>(poseKey(i));
-      const Eigen::Vector3d target = pose * (point + scale * direction.vector()) +
-                                     Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
-      scene.graph.emplace<AllTypesFactor>(poseKey(i), pointKey(g), directionKey(g, 0),
-                                          startLengthKey(g, 0), target);
-    }
-    scene.graph.emplace<PointPriorFactor>(pointKey(g), point + Eigen::Vector3d(0.3, 0.0, 0.0),
-                                          huber);
-    scene.start.insert(pointKey(g), Eigen::Vector3d(point + Eigen::Vector3d(0.2, -0.1, 0.1)));
-    scene.start.insert(directionKey(g, 0), direction.retract(Eigen::Vector2d(0.2, -0.1)));
-    scene.start.insert(startLengthKey(g, 0), scale * 1.2);
-  }
-  return scene;
-}
+Scene makeScene() { return testing::makeToyScene(kGroups, kPoses, 7, 0.0); }
 
 ProblemConfig posesHeld() {
   ProblemConfig config;

@@ -55,4 +55,24 @@ class PointPriorFactor : public NoiseModelFactorN<3, Eigen::Vector3d> {
   Eigen::Vector3d target_;
 };
 
+/// e = t_a - t_b - target (3 rows): a factor over two poses only (their translations).
+class TranslationDifferenceFactor : public NoiseModelFactorN<3, Pose3, Pose3> {
+  using Base = NoiseModelFactorN<3, Pose3, Pose3>;
+
+ public:
+  TranslationDifferenceFactor(Key a, Key b, const Eigen::Vector3d& target, NoiseModel noise = {})
+      : Base({a, b}, noise), target_(target) {}
+  Error evaluateError(const Pose3& a, const Pose3& b, Jacobian<Pose3>* H_a,
+                      Jacobian<Pose3>* H_b) const override {
+    // Pose3's chart moves the translation by the tangent's last three entries.
+    if (H_a) *H_a << Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Identity();
+    if (H_b) *H_b << Eigen::Matrix3d::Zero(), -Eigen::Matrix3d::Identity();
+    return a.translation() - b.translation() - target_;
+  }
+  const char* typeName() const override { return "translation_difference"; }
+
+ private:
+  Eigen::Vector3d target_;
+};
+
 }  // namespace curvesfm::testing

@@ -182,11 +182,24 @@ void countRejection(CorrespondenceCheck failed, KeyframeStats* stats) {
 
 }  // namespace
 
+OptimizerOptions defaultPipelineOptimizerOptions() {
+  OptimizerOptions options;
+  options.linear_solver = LinearSolver::kGraphSchur;
+  return options;
+}
+
 SchedulerOptions defaultLocalBundleAdjustmentOptions() {
   SchedulerOptions options;
+  options.optimizer = defaultPipelineOptimizerOptions();
   options.strategy = Strategy::kAlternating;
   options.scope = Scope::kLocal;
   options.local_window = 5;
+  return options;
+}
+
+SchedulerOptions defaultGlobalBundleAdjustmentOptions() {
+  SchedulerOptions options;
+  options.optimizer = defaultPipelineOptimizerOptions();
   return options;
 }
 

@@ -25,8 +25,15 @@
 
 namespace curvesfm {
 
+/// The solver of every pipeline BA (local, global, pose tracking): our own Schur complement
+/// (LinearSolver::kGraphSchur), 1.9-2.4x faster than Ceres' sparse Schur on the real sets'
+/// global BA with the same figures within their run-to-run variation (docs/benchmarks.md, "Our
+/// own Schur complement").
+OptimizerOptions defaultPipelineOptimizerOptions();
 /// The defaults of PipelineOptions::local_ba: alternating, local scope, a window of 5 keyframes.
 SchedulerOptions defaultLocalBundleAdjustmentOptions();
+/// The defaults of PipelineOptions::global_ba: joint, global scope.
+SchedulerOptions defaultGlobalBundleAdjustmentOptions();
 
 /// The scene scale at which the pipeline's relative defaults equal the stages' metric defaults:
 /// the distance between consecutive true camera centres of the default `curvesfm synth planar`
@@ -105,7 +112,7 @@ struct PipelineOptions {
   /// LinuxLogo 0 % with a 0.1 deg / 2 mm motion prior: 3.24 -> 6.91 mm moving poses, 2.45 mm
   /// holding them; docs/benchmarks.md).
   bool local_ba_refines_poses = false;
-  SchedulerOptions global_ba;  ///< Once at the end (global scope).
+  SchedulerOptions global_ba = defaultGlobalBundleAdjustmentOptions();  ///< Once at the end.
   bool run_global_ba = true;   ///< Run global BA in finish().
   /// After global BA, rounds of re-association, each followed by global BA again: every
   /// promoted curve's segments are checked (registerSegment) in every keyframe that has no
@@ -159,7 +166,7 @@ struct PipelineOptions {
   /// off by centimetres in depth until re-association and global BA fix it.
   bool track_keyframe_pose = false;
   /// Solver of that pose refinement (max_iterations per keyframe).
-  OptimizerOptions tracking;
+  OptimizerOptions tracking = defaultPipelineOptimizerOptions();
   /// Chain pixels within this distance of the projection of a segment registered in the
   /// keyframe count as explained by it; only runs of unexplained pixels (at least
   /// chains.min_length_px long) seed new curves (px). Finite, >= 0.

@@ -275,10 +275,13 @@ class GraphSchurProblem {
           values.toAmbient(key, start_.data() + slot.ambient);
           if (!config.isConstant(key)) {
             ++num_free_;
-            if (categoryOf(key) == VariableCategory::kPose)
+            // Poses by type, so that a pose always has kPoseDim columns; the rest is structure,
+            // whose groups are formed next.
+            if (slot.type == VariableType::kPose3) {
               slot.pose = num_poses_++;
-            else
-              slot.group = 0;  // Structure; its group is formed next.
+            } else {
+              slot.group = 0;
+            }
           }
           slots_.push_back(slot);
         }

@@ -11,19 +11,11 @@
 #include <unordered_map>
 
 #include "core/clock.h"
-#include "core/union_find.h"
 #include "graph/levenberg_marquardt.h"
+#include "graph/variable_slots.h"
 
 namespace curvesfm {
 namespace {
-
-// A variable some factor uses, with its place in the ambient buffer of all such variables.
-struct Slot {
-  Key key;
-  VariableType type = VariableType::kScalar;
-  int ambient = 0;  // Offset in Setup::ambient.
-  bool free = false;
-};
 
 // A factor's key as a component sees it: a free variable (its index in the component) or a
 // constant one (its slot).
@@ -44,60 +36,25 @@ struct ComponentResult {
 };
 
 // Every variable the factors use, their start values, and the independent components.
-struct Setup {
-  std::vector<Slot> slots;
-  std::vector<double> ambient;
-  std::vector<std::vector<int>> factor_slots;  // Per graph factor, its keys' slots.
-  std::vector<Component> components;           // Factors without a free variable are in none.
+struct Setup : VariableSlots {
+  std::vector<Component> components;  // Factors without a free variable are in none.
 };
 
 Setup makeSetup(const FactorGraph& graph, const Values& values, const ProblemConfig& config) {
   Setup setup;
-  std::unordered_map<Key, int> slot_of;
-  setup.factor_slots.resize(graph.size());
-  for (std::size_t f = 0; f < graph.size(); ++f) {
-    const std::vector<VariableType> types = graph[f]->variableTypes();
-    for (std::size_t k = 0; k < types.size(); ++k) {
-      const Key key = graph[f]->keys()[k];
-      if (values.type(key) != types[k]) throw IncorrectType(key, values.type(key), types[k]);
-      auto [it, added] = slot_of.emplace(key, static_cast<int>(setup.slots.size()));
-      if (added) {
-        Slot slot{key, values.type(key), static_cast<int>(setup.ambient.size()),
-                  !config.isConstant(key)};
-        setup.ambient.resize(setup.ambient.size() + ambientDim(slot.type));
-        values.toAmbient(key, setup.ambient.data() + slot.ambient);
-        setup.slots.push_back(slot);
-      }
-      setup.factor_slots[f].push_back(it->second);
-    }
-  }
-
-  UnionFind sets(static_cast<int>(setup.slots.size()));
-  for (std::size_t f = 0; f < graph.size(); ++f) {
-    int first_free = -1;
-    for (const int s : setup.factor_slots[f]) {
-      if (!setup.slots[s].free) continue;
-      if (first_free < 0) first_free = s;
-      sets.join(s, first_free);
-    }
-  }
-  std::unordered_map<int, int> component_of_root;
-  const auto componentOf = [&](int slot) {
-    const auto [it, added] =
-        component_of_root.emplace(sets.find(slot), static_cast<int>(setup.components.size()));
-    if (added) setup.components.emplace_back();
-    return it->second;
-  };
+  static_cast<VariableSlots&>(setup) = collectVariableSlots(graph, values, config);
+  int num_components = 0;
+  const std::vector<int> component_of = connectedSets(
+      setup, [&](int s) { return setup.slots[s].free; }, &num_components);
+  setup.components.resize(num_components);
   for (std::size_t s = 0; s < setup.slots.size(); ++s) {
-    if (setup.slots[s].free) {
-      setup.components[componentOf(static_cast<int>(s))].variables.push_back(static_cast<int>(s));
-    }
+    if (component_of[s] >= 0) setup.components[component_of[s]].variables.push_back(int(s));
   }
   for (std::size_t f = 0; f < graph.size(); ++f) {
     const auto free_slot = std::find_if(setup.factor_slots[f].begin(), setup.factor_slots[f].end(),
                                         [&](int s) { return setup.slots[s].free; });
     if (free_slot != setup.factor_slots[f].end()) {
-      setup.components[componentOf(*free_slot)].factors.push_back(static_cast<int>(f));
+      setup.components[component_of[*free_slot]].factors.push_back(static_cast<int>(f));
     }
   }
   return setup;
@@ -135,7 +92,7 @@ class ComponentProblem {
   std::vector<double> startValues() const {
     std::vector<double> x(ambient_size_);
     for (std::size_t v = 0; v < component_.variables.size(); ++v) {
-      const Slot& slot = setup_.slots[component_.variables[v]];
+      const VariableSlot& slot = setup_.slots[component_.variables[v]];
       std::copy_n(setup_.ambient.begin() + slot.ambient, ambientDim(slot.type),
                   x.begin() + ambient_offset_[v]);
     }
@@ -144,7 +101,7 @@ class ComponentProblem {
 
   void writeBack(const std::vector<double>& x, std::vector<double>* ambient) const {
     for (std::size_t v = 0; v < component_.variables.size(); ++v) {
-      const Slot& slot = setup_.slots[component_.variables[v]];
+      const VariableSlot& slot = setup_.slots[component_.variables[v]];
       std::copy_n(x.begin() + ambient_offset_[v], ambientDim(slot.type),
                   ambient->begin() + slot.ambient);
     }
@@ -324,12 +281,6 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
   return result;
 }
 
-double totalCost(const std::map<std::string, FactorTypeCost>& by_type) {
-  double total = 0.0;
-  for (const auto& [type, cost] : by_type) total += cost.cost;
-  return total;
-}
-
 }  // namespace
 
 bool hasFreePose(const FactorGraph& graph, const ProblemConfig& config) {
@@ -350,7 +301,7 @@ OptimizationSummary optimizeComponents(const FactorGraph& graph, Values* values,
   summary.num_factors = static_cast<int>(graph.size());
   summary.initial_cost_by_type = graph.costByType(*values);
   Setup setup = makeSetup(graph, *values, config);
-  for (const Slot& slot : setup.slots) {
+  for (const VariableSlot& slot : setup.slots) {
     (slot.free ? summary.num_free_variables : summary.num_constant_variables) += 1;
     if (slot.free) summary.num_effective_parameters += tangentDim(slot.type);
   }
@@ -382,7 +333,7 @@ OptimizationSummary optimizeComponents(const FactorGraph& graph, Values* values,
   summary.minimizer_seconds = summary.solve_seconds;
 
   const auto writeback_start = Clock::now();
-  for (const Slot& slot : setup.slots) {
+  for (const VariableSlot& slot : setup.slots) {
     if (slot.free) values->setFromAmbient(slot.key, solved_ambient.data() + slot.ambient);
   }
   summary.final_cost_by_type = graph.costByType(*values);

@@ -4,6 +4,12 @@
 
 namespace curvesfm {
 
+double totalCost(const std::map<std::string, FactorTypeCost>& by_type) {
+  double total = 0.0;
+  for (const auto& [type, cost] : by_type) total += cost.cost;
+  return total;
+}
+
 void FactorGraph::add(FactorPtr factor) {
   CURVESFM_CHECK(factor != nullptr) << "FactorGraph::add: null factor";
   factors_.push_back(std::move(factor));

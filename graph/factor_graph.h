@@ -16,6 +16,9 @@ struct FactorTypeCost {
   double cost = 0.0;  ///< Sum of 0.5 * rho(|r / sigma|^2) over them (Ceres' convention).
 };
 
+/// The sum of the per-type costs (FactorGraph::costByType's total).
+double totalCost(const std::map<std::string, FactorTypeCost>& by_type);
+
 /// A list of factors sharing variables by key. Factors are immutable and shared, so a graph is
 /// cheap to copy and a solver may hold them while the graph changes.
 class FactorGraph {

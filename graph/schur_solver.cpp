@@ -8,11 +8,10 @@
 #include <iomanip>
 #include <sstream>
 #include <thread>
-#include <unordered_map>
 
 #include "core/clock.h"
-#include "core/union_find.h"
 #include "graph/levenberg_marquardt.h"
+#include "graph/variable_slots.h"
 
 namespace curvesfm {
 namespace {
@@ -40,7 +39,6 @@ struct FreeKey {
 
 struct FactorPlan {
   int group = -1;  // The structure group it touches; -1 for none.
-  std::vector<int> slots;
   std::vector<FreeKey> free;
   int free_columns = 0;
 };
@@ -121,7 +119,7 @@ class GraphSchurProblem {
     for (const Group& group : groups_) total += group.dim;
     return total;
   }
-  const std::vector<double>& start() const { return start_; }
+  const std::vector<double>& start() const { return variables_.ambient; }
 
   void prepare(int num_threads) {
     workers_.resize(num_threads);
@@ -132,6 +130,11 @@ class GraphSchurProblem {
       worker.rhs.resize(reducedDimension());
     }
     splitGroups();
+    // Factors with no free key add a constant, as in Ceres' reported costs.
+    fixed_cost_ = 0.0;
+    for (const int f : constant_factors_) {
+      fixed_cost_ += evaluateFactor(variables_.ambient, f, nullptr, false, &workers_[0]);
+    }
   }
 
   // Cost at x; with `linearize`, also every group's H, g and W and the pose terms H_poses,
@@ -261,55 +264,28 @@ class GraphSchurProblem {
 
  private:
   void collectSlots(const Values& values, const ProblemConfig& config) {
-    std::unordered_map<Key, int> slot_of;
+    variables_ = collectVariableSlots(graph_, values, config);
     plans_.resize(graph_.size());
-    for (std::size_t f = 0; f < graph_.size(); ++f) {
-      const std::vector<VariableType> types = graph_[f]->variableTypes();
-      for (std::size_t k = 0; k < types.size(); ++k) {
-        const Key key = graph_[f]->keys()[k];
-        if (values.type(key) != types[k]) throw IncorrectType(key, values.type(key), types[k]);
-        auto [it, added] = slot_of.emplace(key, static_cast<int>(slots_.size()));
-        if (added) {
-          Slot slot{key, types[k], static_cast<int>(start_.size()), tangentDim(types[k])};
-          start_.resize(start_.size() + ambientDim(slot.type));
-          values.toAmbient(key, start_.data() + slot.ambient);
-          if (!config.isConstant(key)) {
-            ++num_free_;
-            // Poses by type, so that a pose always has kPoseDim columns; the rest is structure,
-            // whose groups are formed next.
-            if (slot.type == VariableType::kPose3) {
-              slot.pose = num_poses_++;
-            } else {
-              slot.group = 0;
-            }
-          }
-          slots_.push_back(slot);
-        }
-        plans_[f].slots.push_back(it->second);
+    for (const VariableSlot& variable : variables_.slots) {
+      Slot slot{variable.key, variable.type, variable.ambient, tangentDim(variable.type)};
+      if (variable.free) {
+        ++num_free_;
+        // Poses by type, so that a pose always has kPoseDim columns; the rest is structure.
+        if (slot.type == VariableType::kPose3) slot.pose = num_poses_++;
       }
+      slots_.push_back(slot);
     }
   }
 
-  bool isStructure(int slot) const { return slots_[slot].group >= 0; }
-
   void formGroups() {
-    UnionFind sets(static_cast<int>(slots_.size()));
-    for (const FactorPlan& plan : plans_) {
-      int first = -1;
-      for (const int s : plan.slots) {
-        if (!isStructure(s)) continue;
-        if (first < 0) first = s;
-        sets.join(s, first);
-      }
-    }
-    std::unordered_map<int, int> group_of_root;
+    const auto isStructure = [&](int s) { return variables_.slots[s].free && slots_[s].pose < 0; };
+    int num_groups = 0;
+    const std::vector<int> group_of = connectedSets(variables_, isStructure, &num_groups);
+    groups_.resize(num_groups);
     for (std::size_t s = 0; s < slots_.size(); ++s) {
-      if (!isStructure(static_cast<int>(s))) continue;
-      const auto [it, added] =
-          group_of_root.emplace(sets.find(static_cast<int>(s)), static_cast<int>(groups_.size()));
-      if (added) groups_.emplace_back();
       Slot& slot = slots_[s];
-      slot.group = it->second;
+      slot.group = group_of[s];
+      if (slot.group < 0) continue;
       slot.offset = groups_[slot.group].dim;
       groups_[slot.group].dim += slot.dim;
     }
@@ -318,17 +294,18 @@ class GraphSchurProblem {
   void planFactors() {
     for (std::size_t f = 0; f < graph_.size(); ++f) {
       FactorPlan& plan = plans_[f];
+      const std::vector<int>& keys = variables_.factor_slots[f];
       bool any_free = false;
-      for (std::size_t k = 0; k < plan.slots.size(); ++k) {
-        const Slot& slot = slots_[plan.slots[k]];
+      for (std::size_t k = 0; k < keys.size(); ++k) {
+        const Slot& slot = slots_[keys[k]];
         if (slot.pose < 0 && slot.group < 0) continue;
         any_free = true;
         if (slot.group >= 0) plan.group = slot.group;
-        plan.free.push_back({static_cast<int>(k), plan.slots[k], 0});
+        plan.free.push_back({static_cast<int>(k), keys[k], 0});
         plan.free_columns += slot.dim;
       }
       if (!any_free) {
-        fixed_cost_ += graph_[f]->cost(valuesOf(plan));
+        constant_factors_.push_back(static_cast<int>(f));
       } else if (plan.group < 0) {
         pose_factors_.push_back(static_cast<int>(f));
       } else {
@@ -351,31 +328,6 @@ class GraphSchurProblem {
         }
       }
     }
-  }
-
-  // The start values of a factor's keys, for the cost of a factor with no free key.
-  Values valuesOf(const FactorPlan& plan) const {
-    Values values;
-    for (const int s : plan.slots) {
-      const Slot& slot = slots_[s];
-      if (values.exists(slot.key)) continue;
-      switch (slot.type) {
-        case VariableType::kPose3:
-          values.insert(slot.key, Pose3::fromAmbient(start_.data() + slot.ambient));
-          break;
-        case VariableType::kPoint3:
-          values.insert(slot.key,
-                        Eigen::Vector3d(Eigen::Vector3d::Map(start_.data() + slot.ambient)));
-          break;
-        case VariableType::kDirection:
-          values.insert(slot.key, Direction::fromAmbient(start_.data() + slot.ambient));
-          break;
-        case VariableType::kScalar:
-          values.insert(slot.key, start_[slot.ambient]);
-          break;
-      }
-    }
-    return values;
   }
 
   // Threads take contiguous runs of groups of about equal factor counts, always the same for a
@@ -408,11 +360,12 @@ class GraphSchurProblem {
                         Worker* worker) {
     const Factor& factor = *graph_[f];
     const FactorPlan& plan = plans_[f];
+    const std::vector<int>& keys = variables_.factor_slots[f];
     const int rows = factor.residualDimension();
-    worker->ambient.resize(plan.slots.size());
-    worker->jacobians.assign(plan.slots.size(), nullptr);
-    for (std::size_t k = 0; k < plan.slots.size(); ++k) {
-      worker->ambient[k] = x.data() + slots_[plan.slots[k]].ambient;
+    worker->ambient.resize(keys.size());
+    worker->jacobians.assign(keys.size(), nullptr);
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+      worker->ambient[k] = x.data() + slots_[keys[k]].ambient;
     }
     if (linearize) {
       worker->jacobian_storage.resize(static_cast<std::size_t>(rows) * plan.free_columns);
@@ -528,11 +481,12 @@ class GraphSchurProblem {
   }
 
   const FactorGraph& graph_;
-  std::vector<Slot> slots_;
-  std::vector<double> start_;
+  VariableSlots variables_;
+  std::vector<Slot> slots_;  // Index-aligned with variables_.slots.
   std::vector<FactorPlan> plans_;
   std::vector<Group> groups_;
   std::vector<int> pose_factors_;
+  std::vector<int> constant_factors_;
   double fixed_cost_ = 0.0;
   int num_poses_ = 0;
   int num_free_ = 0;
@@ -543,12 +497,6 @@ class GraphSchurProblem {
   Eigen::MatrixXd S_;
   Eigen::VectorXd pose_step_;
 };
-
-double totalCost(const std::map<std::string, FactorTypeCost>& by_type) {
-  double total = 0.0;
-  for (const auto& [type, cost] : by_type) total += cost.cost;
-  return total;
-}
 
 std::string timingReport(const Outcome& outcome) {
   // The labels of Ceres' FullReport, so the benches read both the same way.

@@ -15,7 +15,9 @@
 // Columns: "build s" = fields + graph; "s/iteration" = Ceres' minimiser wall time / iterations
 // (iteration 0's evaluation and the first symbolic factorisation included); "CPU s/iteration" =
 // CPU time of the whole solve / iterations, the steadier figure on a shared machine;
-// "evaluation %" and "linear solver %" = shares of the minimiser time from Ceres' FullReport.
+// "evaluation %" and "linear solver %" = shares of the minimiser time from Ceres' FullReport;
+// "final cost" = the objective after the solve (the same start and iterations must give the
+// same value with every linear solver, up to the path the rough edge cost lets it take).
 //
 // Output: a markdown table (one row per configuration) on stdout, then `key: value` headline
 // figures; one progress line per configuration on stderr; with --out, scaling.csv. Linux only
@@ -45,6 +47,7 @@
 
 #include "benchmarks/support/bench_common.h"
 #include "core/check.h"
+#include "core/dense_kernels.h"
 #include "core/errors.h"
 #include "factors/curve_bundle_adjustment.h"
 #include "graph/scheduler.h"
@@ -136,6 +139,9 @@ struct SolveFigures {
   /// CPU time of the process over the whole schedule (setup and preprocessing included): on a
   /// loaded machine the wall times above grow, this hardly does.
   double cpu_seconds = 0.0;
+  /// The objective after the solve: the same start and iterations must end at the same value
+  /// whichever solver ran them.
+  double final_cost = 0.0;
 
   double secondsPerIteration() const {
     return iterations > 0 ? minimizer_seconds / iterations : 0.0;
@@ -270,6 +276,7 @@ SolveFigures solveFigures(const OptimizationSummary& summary) {
   if (!ordering.empty()) copyText(ordering.back(), f.schur_blocks, sizeof(f.schur_blocks));
   f.effective_parameters = summary.num_effective_parameters;
   f.iterations = summary.iterations;
+  f.final_cost = summary.final_cost;
   // Ceres counts iteration 0, the starting point, as a successful step.
   f.successful_steps =
       std::max(0, static_cast<int>(reportNumber(report, "\nSuccessful steps")) - 1);
@@ -365,6 +372,7 @@ bool readAll(int fd, void* data, std::size_t size) {
     copyText("unknown exception", m.error, sizeof(m.error));
   }
   writeAll(fd, &m, sizeof(m));
+  std::fflush(stdout);  // _exit drops buffered output: --verbose's logs when stdout is a file.
   _exit(0);  // Skips destructors of large problems and the parent's atexit handlers.
 }
 
@@ -416,8 +424,8 @@ double mib(double kib) { return kib / 1024.0; }
 constexpr const char* kTableHeader =
     "| sweep | keyframes | segments | observations | samples | scene s | build s | s/iteration | "
     "CPU s/iteration | "
-    "evaluation % | linear solver % | peak RSS MiB | BA RSS MiB | fields MiB |\n"
-    "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    "evaluation % | linear solver % | peak RSS MiB | BA RSS MiB | fields MiB | final cost |\n"
+    "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
 
 std::string tableRow(const Row& row) {
   const Measurement& m = row.m;
@@ -427,12 +435,13 @@ std::string tableRow(const Row& row) {
   char line[512];
   std::snprintf(
       line, sizeof(line),
-      "| %s | %d | %d | %d | %d | %.2f | %.2f | %.3f | %.3f | %.0f | %.0f | %.0f | %s | %.0f |",
+      "| %s | %d | %d | %d | %d | %.2f | %.2f | %.3f | %.3f | %.0f | %.0f | %.0f | %s | %.0f | "
+      "%.6g |",
       row.configuration.sweep.c_str(), m.keyframes, m.segments, m.observations, m.samples,
       m.scene_seconds, m.field_seconds + m.graph_seconds, solve.secondsPerIteration(),
       solve.cpuSecondsPerIteration(), solve.percentOfMinimizer(solve.evaluation_seconds),
       solve.percentOfMinimizer(solve.linear_solver_seconds), mib(row.peak_rss_kib), ba_rss,
-      mib(m.field_bytes / 1024.0));
+      mib(m.field_bytes / 1024.0), solve.final_cost);
   return line;
 }
 
@@ -443,7 +452,7 @@ void writeCsv(const std::vector<Row>& rows, const std::filesystem::path& path) {
          "factors,effective_parameters,schur_blocks,iterations,successful_steps,scene_seconds,"
          "field_seconds,graph_seconds,setup_seconds,solve_seconds,minimizer_seconds,"
          "seconds_per_iteration,cpu_seconds,evaluation_seconds,linear_solver_seconds,peak_rss_mib,"
-         "ba_peak_rss_mib,field_mib,ordering\n";
+         "ba_peak_rss_mib,field_mib,final_cost,ordering\n";
   for (const Row& row : rows) {
     const Measurement& m = row.m;
     const SolveFigures& solve = m.solve;
@@ -456,7 +465,7 @@ void writeCsv(const std::vector<Row>& rows, const std::filesystem::path& path) {
         << "," << solve.secondsPerIteration() << "," << solve.cpu_seconds << ","
         << solve.evaluation_seconds << "," << solve.linear_solver_seconds << ","
         << mib(row.peak_rss_kib) << "," << mib(m.ba_peak_kib) << "," << mib(m.field_bytes / 1024.0)
-        << ",\"" << solve.ordering << "\"\n";
+        << "," << solve.final_cost << ",\"" << solve.ordering << "\"\n";
   }
 }
 
@@ -524,6 +533,7 @@ void printHeadline(const std::vector<Row>& rows) {
     bench::printText("schur_blocks_max_" + sweep, solve.schur_blocks);
     bench::print("cpu_time_per_iteration_s_max_" + sweep, solve.cpuSecondsPerIteration());
     bench::print("cpu_time_per_iteration_exponent_vs_" + sweep, cpuTimeExponent(rows, sweep));
+    bench::print("final_cost_max_" + sweep, solve.final_cost);
   }
   bench::print("ba_kib_per_observation_beyond_fields", kibPerObservation(rows));
   bench::printText("ordering", rows.back().m.solve.ordering);
@@ -534,11 +544,12 @@ void printSettings(const BenchOptions& options) {
   std::printf(
       "# scaling_bench: images %dx%d, 360 deg orbit (r = 3 m) in a 12 x 3 x 12 m room, %d "
       "segments per curve, %d samples per observation; joint solves of %d LM iterations (median of "
-      "%d), %s, %d solver thread(s), %s; each configuration in its own process\n\n",
+      "%d), %s, %d solver thread(s), %s, dense kernels %s; each configuration in its own "
+      "process\n\n",
       scene.intrinsics.width, scene.intrinsics.height, options.segments_per_curve,
       options.samples_per_segment + 1, options.iterations, options.repeats,
       options.linear_solver.c_str(), options.threads,
-      options.curve_blocks ? "a block per curve" : "a block per variable");
+      options.curve_blocks ? "a block per curve" : "a block per variable", dense::kernelVariant());
 }
 
 int run(const BenchOptions& options) {

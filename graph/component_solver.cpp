@@ -7,10 +7,10 @@
 #include <cstdio>
 #include <map>
 #include <sstream>
-#include <thread>
 #include <unordered_map>
 
 #include "core/clock.h"
+#include "core/parallel.h"
 #include "graph/levenberg_marquardt.h"
 #include "graph/variable_slots.h"
 
@@ -325,10 +325,7 @@ OptimizationSummary optimizeComponents(const FactorGraph& graph, Values* values,
     options.on_iteration({0, totalCost(summary.initial_cost_by_type), secondsSince(start), false});
   }
   const int num_threads = std::min(options.num_threads, std::max(1, num_components));
-  std::vector<std::thread> threads;
-  for (int t = 1; t < num_threads; ++t) threads.emplace_back(work);
-  work();
-  for (std::thread& thread : threads) thread.join();
+  runInParallel(num_threads, [&](int) { work(); });
   summary.solve_seconds = secondsSince(solve_start);
   summary.minimizer_seconds = summary.solve_seconds;
 

@@ -6,10 +6,13 @@
 #include <cstdio>
 #include <functional>
 #include <iomanip>
+#include <map>
 #include <sstream>
-#include <thread>
 
 #include "core/clock.h"
+#include "core/dense_kernels.h"
+#include "core/parallel.h"
+#include "core/parallel_cholesky.h"
 #include "graph/levenberg_marquardt.h"
 #include "graph/variable_slots.h"
 
@@ -17,6 +20,7 @@ namespace curvesfm {
 namespace {
 
 constexpr int kPoseDim = 6;
+using PoseBlock = Eigen::Matrix<double, kPoseDim, kPoseDim>;
 using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 // A variable some factor uses.
@@ -34,38 +38,73 @@ struct Slot {
 struct FreeKey {
   int key = 0;  // Position in the factor's keys.
   int slot = 0;
-  int local_pose = 0;  // Poses of a group's factor: index in Group::poses.
+  int local_pose = 0;  // Poses of a group's factor: its row block in Group::W.
 };
 
 struct FactorPlan {
   int group = -1;  // The structure group it touches; -1 for none.
   std::vector<FreeKey> free;
   int free_columns = 0;
+  // Where its J_a^T J_b goes for each pair of free poses a >= b: J's columns of a and b, and
+  // the pose pair's index.
+  struct PoseTerm {
+    int column_a = 0;
+    int column_b = 0;
+    int pair = 0;
+  };
+  std::vector<PoseTerm> pose_terms;
 };
+
+// Two free poses some factor joins, first >= second: a 6 x 6 lower block of the reduced system.
+struct PosePair {
+  int first = 0;
+  int second = 0;
+};
+
+// Consecutive free poses, first to first + count - 1, whose row blocks of a group's W start at
+// row block `local`.
+struct PoseRun {
+  int first = 0;
+  int count = 0;
+  int local = 0;
+};
+
+// A run may take in up to this many poses a group does not see (zero rows of W), so that its
+// share of the reduced system goes in as a few large products rather than many small ones.
+constexpr int kMaxPoseGap = 2;
 
 // Structure variables joined by factors, eliminated together, and what one linearisation and
 // one elimination leave of them.
 struct Group {
   std::vector<int> factors;
-  std::vector<int> poses;  // Free pose indices its factors touch, ascending.
+  std::vector<PoseRun> runs;  // Covering the free poses its factors touch, ascending.
+  int local_poses = 0;        // Poses the runs cover.
   int dim = 0;
   Eigen::MatrixXd H;                // Gauss-Newton block of the group (dim x dim) ...
   Eigen::VectorXd g;                // ... its gradient ...
-  Eigen::MatrixXd W;                // ... and its coupling to its poses (6 poses.size() x dim).
-  Eigen::LLT<Eigen::MatrixXd> llt;  // Of the damped H.
-  Eigen::MatrixXd V;                // L^-1 W^T.
+  Eigen::MatrixXd W;                // ... and its coupling to its poses (6 local_poses x dim).
+  Eigen::MatrixXd L;                // The Cholesky factor of the damped H (lower triangle).
+  Eigen::MatrixXd V;                // W L^-T.
   Eigen::VectorXd u;                // L^-1 g.
   Eigen::VectorXd step;
   double cost = 0.0;
 };
 
+// Where one column of a factor's Jacobian goes.
+struct ColumnPlace {
+  int structure = -1;  // Its column in the group's H, W and g; -1 for a pose column ...
+  int w_row = 0;       // ... whose row in the group's W ...
+  int pose_row = 0;    // ... and in the reduced system.
+};
+
 // One thread's scratch and its share of the reduced system.
 struct Worker {
-  Eigen::MatrixXd H_poses;  // Pose-pose terms of its factors (lower blocks).
+  std::vector<PoseBlock> pose_terms;  // Pose-pose terms of its factors, per pose pair.
   Eigen::VectorXd g_poses;
-  Eigen::MatrixXd S;      // Its groups' share of - W A^-1 W^T (lower blocks) ...
-  Eigen::VectorXd rhs;    // ... and of W A^-1 g.
-  std::vector<double> M;  // One group's V^T V; kept, since fresh pages of that size cost more.
+  // Its groups' share of - W A^-1 W^T (lower triangle; thread 0 writes into the reduced system
+  // itself) ...
+  Eigen::MatrixXd S;
+  Eigen::VectorXd rhs;  // ... and of W A^-1 g.
   bool eliminated = true;
   // One factor's evaluation.
   std::vector<const double*> ambient;
@@ -76,6 +115,7 @@ struct Worker {
   Eigen::VectorXd r;
   Eigen::MatrixXd JtJ;
   Eigen::VectorXd Jtr;
+  std::vector<ColumnPlace> places;  // Per column of J.
 };
 
 struct Timings {
@@ -123,11 +163,12 @@ class GraphSchurProblem {
 
   void prepare(int num_threads) {
     workers_.resize(num_threads);
-    for (Worker& worker : workers_) {
-      worker.H_poses.resize(reducedDimension(), reducedDimension());
-      worker.g_poses.resize(reducedDimension());
-      worker.S.resize(reducedDimension(), reducedDimension());
-      worker.rhs.resize(reducedDimension());
+    const int n = reducedDimension();
+    S_.resize(n, n);
+    for (std::size_t t = 0; t < workers_.size(); ++t) {
+      workers_[t].g_poses.resize(n);
+      if (t > 0) workers_[t].S.resize(n, n);
+      workers_[t].rhs.resize(n);
     }
     splitGroups();
     // Factors with no free key add a constant, as in Ceres' reported costs.
@@ -137,13 +178,13 @@ class GraphSchurProblem {
     }
   }
 
-  // Cost at x; with `linearize`, also every group's H, g and W and the pose terms H_poses,
-  // g_poses (Triggs-corrected Gauss-Newton, as Ceres).
+  // Cost at x; with `linearize`, also every group's H, g and W and the pose terms
+  // (Triggs-corrected Gauss-Newton, as Ceres).
   double evaluate(const std::vector<double>& x, bool linearize) {
     parallel([&](int t) {
       Worker& worker = workers_[t];
       if (linearize) {
-        worker.H_poses.setZero();
+        worker.pose_terms.assign(pose_pairs_.size(), PoseBlock::Zero());
         worker.g_poses.setZero();
       }
       for (int i = ranges_[t]; i < ranges_[t + 1]; ++i) {
@@ -151,7 +192,7 @@ class GraphSchurProblem {
         if (linearize) {
           group.H.setZero(group.dim, group.dim);
           group.g.setZero(group.dim);
-          group.W.setZero(kPoseDim * static_cast<int>(group.poses.size()), group.dim);
+          group.W.setZero(kPoseDim * group.local_poses, group.dim);
         }
         group.cost = 0.0;
         for (const int f : group.factors) {
@@ -164,14 +205,7 @@ class GraphSchurProblem {
     for (const int f : pose_factors_)
       cost += evaluateFactor(x, f, nullptr, linearize, &workers_[0]);
     for (const Group& group : groups_) cost += group.cost;
-    if (linearize) {
-      H_poses_ = workers_[0].H_poses;
-      g_poses_ = workers_[0].g_poses;
-      for (std::size_t t = 1; t < workers_.size(); ++t) {
-        H_poses_ += workers_[t].H_poses;
-        g_poses_ += workers_[t].g_poses;
-      }
-    }
+    if (linearize) sumPoseTerms();
     return cost;
   }
 
@@ -195,19 +229,14 @@ class GraphSchurProblem {
     timings->eliminate += secondsSince(start);
 
     start = Clock::now();
-    const int n = reducedDimension();
-    pose_step_.resize(n);
-    if (n > 0) {
-      S_ = H_poses_;
-      S_.diagonal() += marquardtDiagonal(H_poses_.diagonal()) * damping;
-      Eigen::VectorXd rhs = -g_poses_;
-      for (const Worker& worker : workers_) {
-        S_ += worker.S;
-        rhs += worker.rhs;
+    pose_step_ = -g_poses_;
+    if (pose_step_.size() > 0) {
+      for (std::size_t t = 1; t < workers_.size(); ++t) {
+        S_.triangularView<Eigen::Lower>() += workers_[t].S;
       }
-      Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(S_);  // In place, from the lower triangle.
-      if (llt.info() != Eigen::Success) return false;
-      pose_step_ = llt.solve(rhs);
+      for (const Worker& worker : workers_) pose_step_ += worker.rhs;
+      if (!parallelCholesky(S_, static_cast<int>(workers_.size()))) return false;
+      choleskySolveInPlace(S_, &pose_step_);
     }
     timings->reduced += secondsSince(start);
 
@@ -216,7 +245,7 @@ class GraphSchurProblem {
       for (int i = ranges_[t]; i < ranges_[t + 1]; ++i) backSubstitute(&groups_[i]);
     });
     double gx = g_poses_.dot(pose_step_);
-    double xDx = pose_step_.dot(marquardtDiagonal(H_poses_.diagonal()).cwiseProduct(pose_step_));
+    double xDx = pose_step_.dot(marquardtDiagonal(pose_diagonal_).cwiseProduct(pose_step_));
     for (const Group& group : groups_) {
       gx += group.g.dot(group.step);
       xDx += group.step.dot(marquardtDiagonal(group.H.diagonal()).cwiseProduct(group.step));
@@ -292,6 +321,7 @@ class GraphSchurProblem {
   }
 
   void planFactors() {
+    std::map<std::pair<int, int>, int> pair_of;
     for (std::size_t f = 0; f < graph_.size(); ++f) {
       FactorPlan& plan = plans_[f];
       const std::vector<int>& keys = variables_.factor_slots[f];
@@ -309,24 +339,57 @@ class GraphSchurProblem {
       } else if (plan.group < 0) {
         pose_factors_.push_back(static_cast<int>(f));
       } else {
-        Group& group = groups_[plan.group];
-        group.factors.push_back(static_cast<int>(f));
-        for (const FreeKey& key : plan.free) {
-          if (slots_[key.slot].pose >= 0) group.poses.push_back(slots_[key.slot].pose);
-        }
+        groups_[plan.group].factors.push_back(static_cast<int>(f));
+      }
+      planPoseTerms(&plan, &pair_of);
+    }
+    for (Group& group : groups_) planPoseRuns(&group);
+  }
+
+  void planPoseRuns(Group* group) {
+    std::vector<int> poses;
+    for (const int f : group->factors) {
+      for (const FreeKey& key : plans_[f].free) {
+        if (slots_[key.slot].pose >= 0) poses.push_back(slots_[key.slot].pose);
       }
     }
-    for (Group& group : groups_) {
-      std::sort(group.poses.begin(), group.poses.end());
-      group.poses.erase(std::unique(group.poses.begin(), group.poses.end()), group.poses.end());
-      for (const int f : group.factors) {
-        for (FreeKey& key : plans_[f].free) {
-          const int pose = slots_[key.slot].pose;
-          if (pose < 0) continue;
-          key.local_pose = static_cast<int>(
-              std::lower_bound(group.poses.begin(), group.poses.end(), pose) - group.poses.begin());
-        }
+    std::sort(poses.begin(), poses.end());
+    std::vector<PoseRun>& runs = group->runs;
+    for (const int pose : poses) {
+      if (!runs.empty() && pose - (runs.back().first + runs.back().count) <= kMaxPoseGap) {
+        runs.back().count = pose - runs.back().first + 1;
+      } else {
+        runs.push_back({pose, 1, group->local_poses});
       }
+      group->local_poses = runs.back().local + runs.back().count;
+    }
+    for (const int f : group->factors) {
+      for (FreeKey& key : plans_[f].free) {
+        const int pose = slots_[key.slot].pose;
+        if (pose < 0) continue;
+        const auto run = std::prev(std::upper_bound(
+            runs.begin(), runs.end(), pose, [](int p, const PoseRun& r) { return p < r.first; }));
+        key.local_pose = run->local + pose - run->first;
+      }
+    }
+  }
+
+  void planPoseTerms(FactorPlan* plan, std::map<std::pair<int, int>, int>* pair_of) {
+    int column_a = 0;
+    for (const FreeKey& a : plan->free) {
+      const int pose_a = slots_[a.slot].pose;
+      int column_b = 0;
+      for (const FreeKey& b : plan->free) {
+        const int pose_b = slots_[b.slot].pose;
+        if (pose_a >= 0 && pose_b >= 0 && pose_a >= pose_b) {
+          const auto [it, added] = pair_of->emplace(std::make_pair(pose_a, pose_b),
+                                                    static_cast<int>(pose_pairs_.size()));
+          if (added) pose_pairs_.push_back({pose_a, pose_b});
+          plan->pose_terms.push_back({column_a, column_b, it->second});
+        }
+        column_b += slots_[b.slot].dim;
+      }
+      column_a += slots_[a.slot].dim;
     }
   }
 
@@ -349,11 +412,24 @@ class GraphSchurProblem {
   }
 
   void parallel(const std::function<void(int)>& work) const {
-    std::vector<std::thread> threads;
-    for (std::size_t t = 1; t < workers_.size(); ++t)
-      threads.emplace_back(work, static_cast<int>(t));
-    work(0);
-    for (std::thread& thread : threads) thread.join();
+    runInParallel(static_cast<int>(workers_.size()), work);
+  }
+
+  void sumPoseTerms() {
+    g_poses_ = workers_[0].g_poses;
+    pose_terms_ = workers_[0].pose_terms;
+    for (std::size_t t = 1; t < workers_.size(); ++t) {
+      g_poses_ += workers_[t].g_poses;
+      for (std::size_t i = 0; i < pose_terms_.size(); ++i)
+        pose_terms_[i] += workers_[t].pose_terms[i];
+    }
+    pose_diagonal_.setZero(reducedDimension());
+    for (std::size_t i = 0; i < pose_pairs_.size(); ++i) {
+      const PosePair& pair = pose_pairs_[i];
+      if (pair.first == pair.second) {
+        pose_diagonal_.segment<kPoseDim>(kPoseDim * pair.first) = pose_terms_[i].diagonal();
+      }
+    }
   }
 
   double evaluateFactor(const std::vector<double>& x, int f, Group* group, bool linearize,
@@ -392,92 +468,125 @@ class GraphSchurProblem {
                   Group* group, Worker* worker) const {
     Eigen::MatrixXd& J = worker->J;
     J.resize(rows, plan.free_columns);
-    int column = 0;
+    std::vector<ColumnPlace>& places = worker->places;
+    places.clear();
     for (const FreeKey& key : plan.free) {
-      const int dim = slots_[key.slot].dim;
-      J.middleCols(column, dim) =
-          Eigen::Map<const RowMajorMatrix>(worker->jacobians[key.key], rows, dim);
-      column += dim;
+      const Slot& slot = slots_[key.slot];
+      J.middleCols(places.size(), slot.dim) =
+          Eigen::Map<const RowMajorMatrix>(worker->jacobians[key.key], rows, slot.dim);
+      for (int i = 0; i < slot.dim; ++i) {
+        places.push_back(slot.pose >= 0 ? ColumnPlace{-1, kPoseDim * key.local_pose + i,
+                                                      kPoseDim * slot.pose + i}
+                                        : ColumnPlace{slot.offset + i, 0, 0});
+      }
     }
     worker->r = Eigen::Map<const Eigen::VectorXd>(worker->error.data(), rows);
     whitenAndCorrect(sigma, s, rho, &J, &worker->r);
-    // A few dozen columns: lazy products skip the blocked GEMM's packing.
-    worker->JtJ.noalias() = J.transpose().lazyProduct(J);
+    // A few dozen columns: lazy products skip the blocked GEMM's packing. J^T J's lower
+    // triangle only, read as JtJ(max, min).
+    Eigen::MatrixXd& JtJ = worker->JtJ;
+    JtJ.resize(plan.free_columns, plan.free_columns);
+    JtJ.triangularView<Eigen::Lower>() = J.transpose().lazyProduct(J);
     worker->Jtr.noalias() = J.transpose().lazyProduct(worker->r);
-    int ca = 0;
-    for (const FreeKey& a : plan.free) {
-      const Slot& sa = slots_[a.slot];
-      if (sa.pose >= 0) {
-        worker->g_poses.segment<kPoseDim>(kPoseDim * sa.pose) += worker->Jtr.segment<kPoseDim>(ca);
-      } else {
-        group->g.segment(sa.offset, sa.dim) += worker->Jtr.segment(ca, sa.dim);
+    // Column by column rather than block by block: the blocks are 1 to 6 wide, and a
+    // dynamic-size block costs more to set up than to add.
+    const int n = plan.free_columns;
+    for (int c = 0; c < n; ++c) {
+      const int column = places[c].structure;
+      if (column < 0) {
+        worker->g_poses[places[c].pose_row] += worker->Jtr[c];
+        continue;
       }
-      int cb = 0;
-      for (const FreeKey& b : plan.free) {
-        const Slot& sb = slots_[b.slot];
-        const auto block = worker->JtJ.block(ca, cb, sa.dim, sb.dim);
-        if (sa.group >= 0 && sb.group >= 0) {
-          group->H.block(sa.offset, sb.offset, sa.dim, sb.dim) += block;
-        } else if (sa.pose >= 0 && sb.group >= 0) {
-          group->W.block(kPoseDim * a.local_pose, sb.offset, kPoseDim, sb.dim) += block;
-        } else if (sa.pose >= 0 && sb.pose >= 0 && sa.pose >= sb.pose) {  // Lower blocks.
-          worker->H_poses.block<kPoseDim, kPoseDim>(kPoseDim * sa.pose, kPoseDim * sb.pose) +=
-              block;
+      group->g[column] += worker->Jtr[c];
+      for (int k = 0; k < n; ++k) {
+        const ColumnPlace& place = places[k];
+        const double value = k >= c ? JtJ(k, c) : JtJ(c, k);
+        if (place.structure >= 0) {
+          group->H(place.structure, column) += value;
+        } else {
+          group->W(place.w_row, column) += value;
         }
-        cb += sb.dim;
       }
-      ca += sa.dim;
+    }
+    for (const FactorPlan::PoseTerm& term : plan.pose_terms) {
+      const int a = term.column_a, b = term.column_b;
+      PoseBlock& sum = worker->pose_terms[term.pair];
+      if (a == b) {
+        sum += PoseBlock(JtJ.block<kPoseDim, kPoseDim>(a, a).selfadjointView<Eigen::Lower>());
+      } else if (a > b) {
+        sum += JtJ.block<kPoseDim, kPoseDim>(a, b);
+      } else {
+        sum += JtJ.block<kPoseDim, kPoseDim>(b, a).transpose();
+      }
     }
   }
 
   // Factors this thread's groups' damped blocks and adds their share of the reduced system.
   void eliminate(double damping, int thread) {
     Worker* worker = &workers_[thread];
-    worker->S.setZero();
+    Eigen::MatrixXd& S = thread == 0 ? S_ : worker->S;
+    S.triangularView<Eigen::Lower>().setZero();
+    if (thread == 0) addPoseTerms(damping);
     worker->rhs.setZero();
     worker->eliminated = true;
     for (int i = ranges_[thread]; i < ranges_[thread + 1]; ++i) {
       Group& group = groups_[i];
-      Eigen::MatrixXd A = group.H;
-      A.diagonal() += marquardtDiagonal(group.H.diagonal()) * damping;
-      group.llt.compute(A);
-      if (group.llt.info() != Eigen::Success) {
+      group.L = group.H;
+      group.L.diagonal() += marquardtDiagonal(group.H.diagonal()) * damping;
+      if (!dense::factorLower(dense::blockSpan(group.L, 0, 0, group.dim, group.dim))) {
         worker->eliminated = false;
         return;
       }
-      group.V = group.W.transpose();
-      group.llt.matrixL().solveInPlace(group.V);
+      const auto L = group.L.triangularView<Eigen::Lower>();
+      group.V = group.W;
+      dense::solveLowerTransposedRight(dense::blockSpan(group.L, 0, 0, group.dim, group.dim),
+                                       dense::blockSpan(group.V, 0, 0, group.V.rows(), group.dim));
       group.u = group.g;
-      group.llt.matrixL().solveInPlace(group.u);
-      const int m = static_cast<int>(group.poses.size());
-      if (m == 0) continue;
-      worker->M.resize(
-          std::max<std::size_t>(worker->M.size(), std::size_t(kPoseDim * m) * kPoseDim * m));
-      Eigen::Map<Eigen::MatrixXd> M(worker->M.data(), kPoseDim * m, kPoseDim * m);
-      M.setZero();
-      M.selfadjointView<Eigen::Lower>().rankUpdate(group.V.transpose());
-      const Eigen::VectorXd Vtu = group.V.transpose() * group.u;
-      for (int a = 0; a < m; ++a) {
-        const int pa = kPoseDim * group.poses[a];
-        worker->rhs.segment<kPoseDim>(pa) += Vtu.segment<kPoseDim>(kPoseDim * a);
-        for (int b = 0; b <= a; ++b) {
-          worker->S.block<kPoseDim, kPoseDim>(pa, kPoseDim * group.poses[b]) -=
-              M.block<kPoseDim, kPoseDim>(kPoseDim * a, kPoseDim * b);
-        }
+      L.solveInPlace(group.u);
+      subtractFromReducedSystem(group, &S, &worker->rhs);
+    }
+  }
+
+  // S -= V V^T and rhs += V u, run by run, straight into their blocks (lower triangle).
+  static void subtractFromReducedSystem(Group& group, Eigen::MatrixXd* S, Eigen::VectorXd* rhs) {
+    const auto rowsOfV = [&](const PoseRun& run) {
+      return dense::blockSpan(group.V, kPoseDim * run.local, 0, kPoseDim * run.count, group.dim);
+    };
+    const auto blockOfS = [&](const PoseRun& a, const PoseRun& b) {
+      return dense::blockSpan(*S, kPoseDim * a.first, kPoseDim * b.first, kPoseDim * a.count,
+                              kPoseDim * b.count);
+    };
+    for (std::size_t i = 0; i < group.runs.size(); ++i) {
+      const PoseRun& a = group.runs[i];
+      rhs->segment(kPoseDim * a.first, kPoseDim * a.count).noalias() +=
+          group.V.middleRows(kPoseDim * a.local, kPoseDim * a.count) * group.u;
+      dense::subtractGramLower(blockOfS(a, a), rowsOfV(a));
+      for (std::size_t j = 0; j < i; ++j) {
+        dense::subtractProductTransposed(blockOfS(a, group.runs[j]), rowsOfV(a),
+                                         rowsOfV(group.runs[j]));
       }
     }
   }
 
-  // x_group = A^-1 (-g - W^T x_poses) = L^-T (-u - V x_poses).
+  // The pose-pose terms and their damping, into the reduced system's lower triangle.
+  void addPoseTerms(double damping) {
+    for (std::size_t i = 0; i < pose_pairs_.size(); ++i) {
+      const PosePair& pair = pose_pairs_[i];
+      S_.block<kPoseDim, kPoseDim>(kPoseDim * pair.first, kPoseDim * pair.second) += pose_terms_[i];
+    }
+    S_.diagonal() += marquardtDiagonal(pose_diagonal_) * damping;
+  }
+
+  // x_group = A^-1 (-g - W^T x_poses) = L^-T (-u - V^T x_poses).
   void backSubstitute(Group* group) const {
-    Eigen::VectorXd poses(kPoseDim * group->poses.size());
-    for (std::size_t a = 0; a < group->poses.size(); ++a) {
-      poses.segment<kPoseDim>(kPoseDim * a) =
-          pose_step_.segment<kPoseDim>(kPoseDim * group->poses[a]);
+    Eigen::VectorXd poses(kPoseDim * group->local_poses);
+    for (const PoseRun& run : group->runs) {
+      poses.segment(kPoseDim * run.local, kPoseDim * run.count) =
+          pose_step_.segment(kPoseDim * run.first, kPoseDim * run.count);
     }
     group->step = -group->u;
-    if (poses.size()) group->step.noalias() -= group->V * poses;
-    group->llt.matrixU().solveInPlace(group->step);
+    if (poses.size()) group->step.noalias() -= group->V.transpose() * poses;
+    group->L.triangularView<Eigen::Lower>().transpose().solveInPlace(group->step);
   }
 
   const FactorGraph& graph_;
@@ -492,9 +601,11 @@ class GraphSchurProblem {
   int num_free_ = 0;
   std::vector<Worker> workers_;
   std::vector<int> ranges_;  // Thread t takes groups [ranges_[t], ranges_[t + 1]).
-  Eigen::MatrixXd H_poses_;
+  std::vector<PosePair> pose_pairs_;
+  std::vector<PoseBlock> pose_terms_;  // Per pose pair, the sum of the workers' terms.
+  Eigen::VectorXd pose_diagonal_;      // The diagonal of the pose-pose terms.
   Eigen::VectorXd g_poses_;
-  Eigen::MatrixXd S_;
+  Eigen::MatrixXd S_;  // The damped reduced system (lower triangle), then its Cholesky factor.
   Eigen::VectorXd pose_step_;
 };
 
@@ -504,7 +615,8 @@ std::string timingReport(const Outcome& outcome) {
   const int iterations = outcome.iterations;
   const int rejected = outcome.rejected;
   std::ostringstream os;
-  os << std::fixed << std::setprecision(6) << "graph_schur: " << iterations << " iterations\n"
+  os << std::fixed << std::setprecision(6) << "graph_schur: " << iterations
+     << " iterations (dense kernels: " << dense::kernelVariant() << ")\n"
      << "Successful steps " << iterations - rejected + 1 << " (the start counts as one)\n"
      << "Unsuccessful steps " << rejected << "\n"
      << "  Residual only evaluation " << timings.cost << "\n"

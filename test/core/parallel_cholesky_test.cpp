@@ -14,9 +14,10 @@ Eigen::MatrixXd randomSpd(int n, unsigned seed) {
 }
 
 // Sizes around the block size (128) and its multiples, where the panels and the area split of
-// the trailing update change shape; 1 to 3 threads, more threads than columns included.
+// the trailing update change shape, and 700, whose first steps are large enough to go to the
+// threads; 1 to 3 threads.
 TEST(ParallelCholesky, MatchesEigensFactorAndSolvesOnAnyThreadCount) {
-  for (const int n : {1, 7, 127, 128, 129, 300}) {
+  for (const int n : {1, 7, 127, 128, 129, 300, 700}) {
     const Eigen::MatrixXd a = randomSpd(n, 17 + n);
     const Eigen::MatrixXd expected = Eigen::LLT<Eigen::MatrixXd>(a).matrixL();
     const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(n, -1.0, 2.0);

@@ -97,6 +97,7 @@ class Camera {
 
  private:
   CameraIntrinsics intrinsics_;
+  bool distorted_ = false;  ///< hasDistortion(), once.
 };
 
 }  // namespace curvesfm

@@ -103,7 +103,7 @@ bool Camera::project(const Eigen::Vector3d& point_in_cam, Eigen::Vector2d* pixel
   double yd = y;
   double J[4] = {1.0, 0.0, 0.0, 1.0};
   // The pipeline's keyframes are undistorted: skipping the model there changes no bit of the
-  // result (the identity it computes is exact) and saves 3 % of a curve sample's cost.
+  // result (the identity it computes is exact) and saves about 2.5 % of a curve sample's cost.
   if (distorted_) distort(c, x, y, &xd, &yd, H_point ? J : nullptr);
   (*pixel)(0) = c.fx * xd + c.cx;
   (*pixel)(1) = c.fy * yd + c.cy;

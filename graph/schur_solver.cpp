@@ -1,6 +1,5 @@
 #include "graph/schur_solver.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -533,16 +532,16 @@ class GraphSchurProblem {
       Group& group = groups_[i];
       group.L = group.H;
       group.L.diagonal() += marquardtDiagonal(group.H.diagonal()) * damping;
-      if (!dense::factorLower(dense::blockSpan(group.L, 0, 0, group.dim, group.dim))) {
+      const dense::MatrixSpan L = dense::blockSpan(group.L, 0, 0, group.dim, group.dim);
+      if (!dense::factorLower(L)) {
         worker->eliminated = false;
         return;
       }
-      const auto L = group.L.triangularView<Eigen::Lower>();
       group.V = group.W;
-      dense::solveLowerTransposedRight(dense::blockSpan(group.L, 0, 0, group.dim, group.dim),
+      dense::solveLowerTransposedRight(L,
                                        dense::blockSpan(group.V, 0, 0, group.V.rows(), group.dim));
       group.u = group.g;
-      L.solveInPlace(group.u);
+      group.L.triangularView<Eigen::Lower>().solveInPlace(group.u);
       subtractFromReducedSystem(group, &S, &worker->rhs);
     }
   }

@@ -23,6 +23,7 @@
 #include "core/dataset_io.h"
 #include "core/errors.h"
 #include "core/median.h"
+#include "core/peak_memory.h"
 #include "core/trajectory_evaluation.h"
 #include "core/tum_dataset.h"
 
@@ -427,8 +428,10 @@ void printSummary(const RunInput& input, const PipelineResult& r, double seconds
       "orientation\n",
       samples.on_field, samples.behind_camera, samples.outside_image, samples.beyond_reach,
       samples.wrong_orientation);
-  std::printf("time: frontend %.2f s, local BA %.2f s, global BA %.2f s, total %.2f s\n", frontend,
-              local_ba, r.globalBaSeconds(), seconds);
+  std::printf(
+      "time: frontend %.2f s, local BA %.2f s, global BA %.2f s, total %.2f s; peak memory %.0f "
+      "MiB\n",
+      frontend, local_ba, r.globalBaSeconds(), seconds, peakResidentMiB());
   printFrontendStages(r.frames);
 }
 
@@ -757,7 +760,8 @@ int RunCommand::run() const {
        {"pose_stages", stageMotionsJson(motions, result.scene_scale)},
        {"curve_statistics", curveStatisticsJson(result.curve_statistics)},
        {"sanity", sanityToJson(result.sanity)},
-       {"total_seconds", seconds}});
+       {"total_seconds", seconds},
+       {"peak_memory_mib", peakResidentMiB()}});
 
   printSummary(input, result, seconds);
   printAte(ate, d.ground_truth_source);

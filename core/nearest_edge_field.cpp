@@ -673,9 +673,17 @@ NearestEdgeField NearestEdgeField::build(const cv::Mat& edges, const cv::Mat& gr
   const EdgeLayout layout = grad_x.type() == CV_16SC1
                                 ? collectEdges<std::int16_t>(edges, grad_x, grad_y, &field.edges_)
                                 : collectEdges<float>(edges, grad_x, grad_y, &field.edges_);
-  field.index_.resize(static_cast<std::size_t>(field.width_) * field.height_);
+  field.wide_index_.resize(static_cast<std::size_t>(field.width_) * field.height_);
   DistanceSweep(layout, field.width_, field.height_, options.max_distance_px)
-      .run(field.index_.data());
+      .run(field.wide_index_.data());
+  if (field.edges_.size() < kNoNarrowIndex) {
+    field.narrow_index_.resize(field.wide_index_.size());
+    std::transform(field.wide_index_.begin(), field.wide_index_.end(), field.narrow_index_.begin(),
+                   [](std::int32_t index) {
+                     return index < 0 ? kNoNarrowIndex : static_cast<std::uint16_t>(index);
+                   });
+    decltype(field.wide_index_)().swap(field.wide_index_);
+  }
   return field;
 }
 

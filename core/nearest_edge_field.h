@@ -43,8 +43,9 @@ struct NearestEdgeFieldOptions {
 /// Built once per keyframe in O(pixels) by an exact separable distance transform that carries the
 /// argmin (per row: the nearest edge pixel in each column, then the best column by a bounded
 /// window search or the lower envelope of parabolas); docs/benchmarks.md compares it with
-/// cv::distanceTransform. Memory: 4 bytes per pixel (an index into the edge list, -1 beyond R)
-/// plus 24 bytes per edge pixel. Immutable after construction, so lookups are thread-safe.
+/// cv::distanceTransform. Memory: 2 bytes per pixel (an index into the edge list) for an image
+/// of fewer than 65,535 edge pixels, 4 for more, plus 24 bytes per edge pixel. Immutable after
+/// construction, so lookups are thread-safe.
 class NearestEdgeField {
  public:
   /// An empty 0 x 0 field (every lookup misses).
@@ -74,9 +75,13 @@ class NearestEdgeField {
   /// A hint that nearest(x, y) is coming: starts loading its cache line, so that a caller with
   /// other work to do meanwhile does not wait for the miss. No effect outside the image.
   void prefetch(double x, double y) const {
-    if (contains(x, y)) {
-      __builtin_prefetch(&index_[static_cast<std::size_t>(static_cast<int>(y + 0.5)) * width_ +
-                                 static_cast<int>(x + 0.5)]);
+    if (!contains(x, y)) return;
+    const std::size_t pixel =
+        static_cast<std::size_t>(static_cast<int>(y + 0.5)) * width_ + static_cast<int>(x + 0.5);
+    if (narrow_index_.empty()) {
+      __builtin_prefetch(&wide_index_[pixel]);
+    } else {
+      __builtin_prefetch(&narrow_index_[pixel]);
     }
   }
 
@@ -89,8 +94,13 @@ class NearestEdgeField {
   /// The nearest edge pixel to pixel (column, row), or nullptr outside the image or beyond R.
   const EdgePixel* nearestToPixel(int column, int row) const {
     if (column < 0 || row < 0 || column >= width_ || row >= height_) return nullptr;
-    const std::int32_t index = index_[static_cast<std::size_t>(row) * width_ + column];
-    return index < 0 ? nullptr : &edges_[static_cast<std::size_t>(index)];
+    const std::size_t pixel = static_cast<std::size_t>(row) * width_ + column;
+    if (narrow_index_.empty()) {
+      const std::int32_t index = wide_index_[pixel];
+      return index < 0 ? nullptr : &edges_[static_cast<std::size_t>(index)];
+    }
+    const std::uint16_t index = narrow_index_[pixel];
+    return index == kNoNarrowIndex ? nullptr : &edges_[index];
   }
 
   /// All edge pixels, in row-major order of their pixels.
@@ -98,7 +108,8 @@ class NearestEdgeField {
 
   /// Bytes held by the field (index map plus edge list).
   std::size_t memoryBytes() const {
-    return index_.capacity() * sizeof(std::int32_t) + edges_.capacity() * sizeof(EdgePixel);
+    return narrow_index_.capacity() * sizeof(std::uint16_t) +
+           wide_index_.capacity() * sizeof(std::int32_t) + edges_.capacity() * sizeof(EdgePixel);
   }
 
  private:
@@ -126,8 +137,12 @@ class NearestEdgeField {
   int width_ = 0;
   int height_ = 0;
   int max_distance_px_ = 0;
-  // Per pixel, row-major: index into edges_, or -1.
-  std::vector<std::int32_t, UninitialisedAllocator<std::int32_t>> index_;
+  // Per pixel, row-major: index into edges_. Two bytes a pixel (kNoNarrowIndex beyond R) when
+  // the image has fewer edge pixels than that, which halves the field of a real image; else four
+  // (-1 beyond R). Exactly one of the two is filled.
+  static constexpr std::uint16_t kNoNarrowIndex = 0xFFFF;
+  std::vector<std::uint16_t> narrow_index_;
+  std::vector<std::int32_t, UninitialisedAllocator<std::int32_t>> wide_index_;
   std::vector<EdgePixel> edges_;
 };
 

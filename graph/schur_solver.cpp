@@ -83,7 +83,6 @@ struct Group {
   Eigen::VectorXd g;                // ... its gradient ...
   Eigen::MatrixXd W;                // ... and its coupling to its poses (6 local_poses x dim).
   Eigen::MatrixXd L;                // The Cholesky factor of the damped H (lower triangle).
-  Eigen::MatrixXd V;                // W L^-T.
   Eigen::VectorXd u;                // L^-1 g.
   Eigen::VectorXd step;
   double cost = 0.0;
@@ -104,6 +103,10 @@ struct Worker {
   // itself) ...
   Eigen::MatrixXd S;
   Eigen::VectorXd rhs;  // ... and of W A^-1 g.
+  // Storage of W L^-T for the group being eliminated: scratch, since a group of a long track
+  // holds a W as large as the rest of its state, and back-substitution can start from W again.
+  // It only grows: a buffer sized per group would go back to the system for every large one.
+  Eigen::VectorXd v_storage;
   bool eliminated = true;
   // One factor's evaluation.
   std::vector<const double*> ambient;
@@ -537,19 +540,21 @@ class GraphSchurProblem {
         worker->eliminated = false;
         return;
       }
-      group.V = group.W;
-      dense::solveLowerTransposedRight(L,
-                                       dense::blockSpan(group.V, 0, 0, group.V.rows(), group.dim));
+      if (worker->v_storage.size() < group.W.size()) worker->v_storage.resize(group.W.size());
+      Eigen::Map<Eigen::MatrixXd> V(worker->v_storage.data(), group.W.rows(), group.W.cols());
+      V = group.W;
+      dense::solveLowerTransposedRight(L, dense::blockSpan(V, 0, 0, V.rows(), group.dim));
       group.u = group.g;
       group.L.triangularView<Eigen::Lower>().solveInPlace(group.u);
-      subtractFromReducedSystem(group, &S, &worker->rhs);
+      subtractFromReducedSystem(group, V, &S, &worker->rhs);
     }
   }
 
   // S -= V V^T and rhs += V u, run by run, straight into their blocks (lower triangle).
-  static void subtractFromReducedSystem(Group& group, Eigen::MatrixXd* S, Eigen::VectorXd* rhs) {
+  static void subtractFromReducedSystem(const Group& group, Eigen::Map<Eigen::MatrixXd>& V,
+                                        Eigen::MatrixXd* S, Eigen::VectorXd* rhs) {
     const auto rowsOfV = [&](const PoseRun& run) {
-      return dense::blockSpan(group.V, kPoseDim * run.local, 0, kPoseDim * run.count, group.dim);
+      return dense::blockSpan(V, kPoseDim * run.local, 0, kPoseDim * run.count, group.dim);
     };
     const auto blockOfS = [&](const PoseRun& a, const PoseRun& b) {
       return dense::blockSpan(*S, kPoseDim * a.first, kPoseDim * b.first, kPoseDim * a.count,
@@ -558,7 +563,7 @@ class GraphSchurProblem {
     for (std::size_t i = 0; i < group.runs.size(); ++i) {
       const PoseRun& a = group.runs[i];
       rhs->segment(kPoseDim * a.first, kPoseDim * a.count).noalias() +=
-          group.V.middleRows(kPoseDim * a.local, kPoseDim * a.count) * group.u;
+          V.middleRows(kPoseDim * a.local, kPoseDim * a.count) * group.u;
       dense::subtractGramLower(blockOfS(a, a), rowsOfV(a));
       for (std::size_t j = 0; j < i; ++j) {
         dense::subtractProductTransposed(blockOfS(a, group.runs[j]), rowsOfV(a),
@@ -576,7 +581,7 @@ class GraphSchurProblem {
     S_.diagonal() += marquardtDiagonal(pose_diagonal_) * damping;
   }
 
-  // x_group = A^-1 (-g - W^T x_poses) = L^-T (-u - V^T x_poses).
+  // x_group = A^-1 (-g - W^T x_poses) = L^-T (-u - L^-1 W^T x_poses).
   void backSubstitute(Group* group) const {
     Eigen::VectorXd poses(kPoseDim * group->local_poses);
     for (const PoseRun& run : group->runs) {
@@ -584,7 +589,11 @@ class GraphSchurProblem {
           pose_step_.segment(kPoseDim * run.first, kPoseDim * run.count);
     }
     group->step = -group->u;
-    if (poses.size()) group->step.noalias() -= group->V.transpose() * poses;
+    if (poses.size()) {
+      Eigen::VectorXd coupling = group->W.transpose() * poses;
+      group->L.triangularView<Eigen::Lower>().solveInPlace(coupling);
+      group->step -= coupling;
+    }
     group->L.triangularView<Eigen::Lower>().transpose().solveInPlace(group->step);
   }
 

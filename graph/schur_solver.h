@@ -29,8 +29,9 @@ namespace curvesfm {
 // differs by rounding between thread counts (each thread sums its own share of the reduced
 // system).
 
-/// The largest reduced system it forms: free poses x 6 (a dense matrix per thread).
-constexpr int kGraphSchurMaxReducedDimension = 3000;
+/// The largest reduced system it forms: free poses x 6 (a dense matrix per thread, 288 MB each
+/// at the limit, still less than Ceres' Jacobians of a 1,000-keyframe sequence).
+constexpr int kGraphSchurMaxReducedDimension = 6000;
 /// The largest structure group it eliminates as one dense block (tangent dimensions).
 constexpr int kGraphSchurMaxGroupDimension = 2000;
 

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <initializer_list>
 #include <limits>
 #include <locale>
@@ -17,9 +18,11 @@
 #include "core/angles.h"
 #include "core/bezier_fit.h"
 #include "core/check.h"
+#include "core/curve_export.h"
 #include "core/errors.h"
 #include "core/so3.h"
 #include "core/trajectory_evaluation.h"
+#include "sim/synthetic_dataset.h"
 
 namespace curvesfm {
 namespace {
@@ -135,6 +138,37 @@ std::vector<Pose3> makeForwardWalk(const CurveSceneOptions& options) {
     poses.push_back(lookAlong(centre, forward));
   }
   return poses;
+}
+
+std::vector<Pose3> makeSidewaysWalk(const CurveSceneOptions& options) {
+  const double wiggle_angle = 2.0 * kDegToRad;
+  std::vector<Pose3> poses;
+  for (int i = 0; i < options.num_keyframes; ++i) {
+    const double s = static_cast<double>(i) / (options.num_keyframes - 1);
+    // The forward walk's wiggle, slowed down to about one period per 10 m so that it stays
+    // gentle between keyframes however long the walk.
+    const double phase = s * std::max(1.0, options.walk_length / 10.0);
+    const Eigen::Vector3d centre(
+        options.walk_length * (s - 0.5), 0.05 * std::sin(3.0 * M_PI * phase),
+        -options.camera_distance + 0.1 * std::sin(2.0 * M_PI * phase + 0.3));
+    const Eigen::Vector3d forward(std::tan(wiggle_angle * std::sin(2.0 * M_PI * phase)),
+                                  std::tan(wiggle_angle * std::cos(3.0 * M_PI * phase)), 1.0);
+    poses.push_back(lookAlong(centre, forward));
+  }
+  return poses;
+}
+
+std::vector<Pose3> makeCameraPath(const CurveSceneOptions& options) {
+  switch (options.camera_path) {
+    case CameraPath::kOrbit:
+      return makeOrbit(options);
+    case CameraPath::kForwardWalk:
+      return makeForwardWalk(options);
+    case CameraPath::kSidewaysWalk:
+      return makeSidewaysWalk(options);
+  }
+  CURVESFM_CHECK(false) << "unknown camera path " << static_cast<int>(options.camera_path);
+  return {};
 }
 
 // ------------------------------------------------------------------------------------------
@@ -768,8 +802,10 @@ double bilinear(const cv::Mat1f& image, double x, double y) {
 void CurveSceneOptions::validate() const {
   const OptionCheck require("CurveSceneOptions");
   require(num_keyframes >= 2, "num_keyframes", num_keyframes, "must be >= 2");
-  require(camera_path == CameraPath::kOrbit || camera_path == CameraPath::kForwardWalk,
-          "camera_path", static_cast<int>(camera_path), "must be kOrbit or kForwardWalk");
+  require(camera_path == CameraPath::kOrbit || camera_path == CameraPath::kForwardWalk ||
+              camera_path == CameraPath::kSidewaysWalk,
+          "camera_path", static_cast<int>(camera_path),
+          "must be kOrbit, kForwardWalk or kSidewaysWalk");
   require(camera_distance > 0.0 && std::isfinite(camera_distance), "camera_distance",
           camera_distance, "must be finite and > 0");
   require(arc_degrees > 0.0 && arc_degrees <= 360.0, "arc_degrees", arc_degrees,
@@ -831,8 +867,7 @@ CurveScene makeCurveScene(const CurveSceneOptions& options) {
   options.validate();
   CurveScene scene;
   scene.camera = std::make_shared<const Camera>(options.intrinsics);
-  scene.true_cam_from_world =
-      options.camera_path == CameraPath::kOrbit ? makeOrbit(options) : makeForwardWalk(options);
+  scene.true_cam_from_world = makeCameraPath(options);
   std::vector<Eigen::Vector3d> centres;
   for (const Pose3& pose : scene.true_cam_from_world) centres.push_back(pose.inverseTranslation());
 
@@ -959,6 +994,25 @@ EdgeAgreement measureEdgeAgreement(const CurveScene& scene, int keyframe, double
     agreement.edge_pixels_near_curves = static_cast<double>(near) / agreement.num_edge_pixels;
   }
   return agreement;
+}
+
+void writeCurveDataset(const std::string& dir, const CurveScene& scene, bool with_initial_poses) {
+  CURVESFM_CHECK(scene.camera) << "a curve scene needs a camera";
+  constexpr double kFramePeriod = 1.0 / 30.0;  // As a 30 Hz camera, the TUM sets' rate.
+  constexpr int kGroundTruthSamplesPerSegment = 64;
+  std::vector<double> timestamps;
+  SyntheticSequence sequence;
+  for (std::size_t k = 0; k < scene.keyframes.size(); ++k) {
+    timestamps.push_back(static_cast<double>(k) * kFramePeriod);
+    sequence.images.push_back(scene.keyframes[k].image);
+  }
+  sequence.camera = scene.camera.get();
+  sequence.timestamps = &timestamps;
+  sequence.true_cam_from_world = &scene.true_cam_from_world;
+  if (with_initial_poses) sequence.initial_cam_from_world = &scene.initial_cam_from_world;
+  writeSyntheticDataset(dir, sequence);
+  writeCurvesObj((std::filesystem::path(dir) / "gt_curves.obj").string(), scene.true_curves,
+                 kGroundTruthSamplesPerSegment);
 }
 
 }  // namespace curvesfm

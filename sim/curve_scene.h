@@ -31,6 +31,12 @@ enum class CameraPath {
   /// and vertical (+-0.05 m) wiggle and a +-2 deg yaw/pitch wiggle. The last keyframe is
   /// camera_distance in front of the room centre, the first one walk_length further back.
   kForwardWalk,
+  /// Along a straight line parallel to the room's x axis, walk_length long and centred on the
+  /// room, camera_distance in front of its centre, looking across the line (+z) as a car's side
+  /// camera, with the forward walk's wiggle (one period per 10 m of a longer walk). Each curve
+  /// stays in view over a bounded stretch: the long-sequence case. Stretch the volume along x
+  /// with the walk (e.g. half extents (walk_length / 2 + 2, 1.5, 1)).
+  kSidewaysWalk,
 };
 
 /// The shape of the curves before they are fitted by poly-Béziers.
@@ -43,9 +49,10 @@ enum class CurveKind {
 
 template <>
 struct EnumNames<CameraPath> {
-  static constexpr std::array<std::pair<CameraPath, const char*>, 2> kNames = {{
+  static constexpr std::array<std::pair<CameraPath, const char*>, 3> kNames = {{
       {CameraPath::kOrbit, "orbit"},
       {CameraPath::kForwardWalk, "forward_walk"},
+      {CameraPath::kSidewaysWalk, "sideways_walk"},
   }};
 };
 template <>
@@ -62,11 +69,11 @@ struct CurveSceneOptions {
   // --- cameras ---
   int num_keyframes = 12;                       ///< Keyframes (images); >= 2.
   CameraPath camera_path = CameraPath::kOrbit;  ///< See CameraPath.
-  /// kOrbit: orbit radius; kForwardWalk: distance from the last keyframe to the room centre (m);
-  /// > 0.
+  /// kOrbit: orbit radius; kForwardWalk: distance from the last keyframe to the room centre;
+  /// kSidewaysWalk: distance of the line from the room centre (m); > 0.
   double camera_distance = 3.0;
   double arc_degrees = 90.0;  ///< kOrbit: angle spanned by the keyframes (deg); (0, 360].
-  double walk_length = 2.0;   ///< kForwardWalk: distance first to last keyframe (m); > 0.
+  double walk_length = 2.0;   ///< The walks: distance first to last keyframe (m); > 0.
   /// 640x480 pinhole with mild barrel distortion, as PointSceneOptions: rendering and
   /// observations go through the distortion model.
   CameraIntrinsics intrinsics{500.0, 500.0, 319.5, 239.5, -0.05, 0.01, 0.0, 0.0, 0.0, 640, 480};
@@ -192,6 +199,14 @@ struct CurveScene {
 /// InvalidOptions for invalid options, and names min_camera_distance if no curve can be placed
 /// in the volume at that distance from every keyframe.
 CurveScene makeCurveScene(const CurveSceneOptions& options);
+
+/// Writes the scene as a dataset in the TUM RGB-D layout (sim/synthetic_dataset.h: rgb.txt,
+/// rgb/, camera.yaml with the distortion, groundtruth.txt, init_poses.txt unless
+/// `with_initial_poses` is false), keyframe k at timestamp k / 30 s, and `dir`/gt_curves.obj, the
+/// true curves as polylines (64 samples per segment) for `curvesfm eval-map --gt-curves`. Throws
+/// IoError naming the path that cannot be created or written.
+void writeCurveDataset(const std::string& dir, const CurveScene& scene,
+                       bool with_initial_poses = true);
 
 /// Errors of an estimate (cam_from_world per keyframe, one curve per true curve, matched by
 /// index; a curve may have any number of segments).

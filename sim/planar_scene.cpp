@@ -4,17 +4,15 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
-#include <system_error>
 
 #include "core/angles.h"
 #include "core/check.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
+#include "sim/synthetic_dataset.h"
 
 namespace curvesfm {
 namespace {
@@ -103,21 +101,6 @@ void fillBehindCamera(const Eigen::RowVector3d& inverse_depth, const cv::Scalar&
     }
   }
   view->setTo(fill, behind);
-}
-
-void createFolder(const std::filesystem::path& folder) {
-  std::error_code error;
-  std::filesystem::create_directories(folder, error);
-  if (error) throw IoError(folder.string(), "cannot create the folder: " + error.message());
-  if (!std::filesystem::is_directory(folder, error)) {
-    throw IoError(folder.string(), "cannot create the folder: a file of that name exists");
-  }
-}
-
-std::string imageName(std::size_t frame) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "rgb/%06zu.png", frame);
-  return name;
 }
 
 }  // namespace
@@ -259,32 +242,14 @@ PlanarScene makePlanarScene(const cv::Mat& texture_bgr, const PlanarSceneOptions
 }
 
 void writePlanarDataset(const std::string& dir, const PlanarScene& scene, bool with_initial_poses) {
-  const std::size_t frames = scene.timestamps.size();
-  CURVESFM_CHECK(scene.camera && scene.images.size() == frames &&
-                 scene.true_cam_from_world.size() == frames &&
-                 scene.initial_cam_from_world.size() == frames)
-      << "a planar scene needs a camera and one image and two poses per timestamp";
-  CURVESFM_CHECK(!dir.empty()) << "the dataset folder must be named";
-  const std::filesystem::path root(dir);
-  createFolder(root);
-  createFolder(root / "rgb");
-  std::vector<ImageEntry> entries;
-  for (std::size_t i = 0; i < frames; ++i) {
-    entries.push_back({scene.timestamps[i], imageName(i)});
-    writeImage((root / entries.back().path).string(), scene.images[i]);
-  }
-  writeImageList((root / "rgb.txt").string(), entries);
-  writeCameraYaml((root / "camera.yaml").string(), *scene.camera);
-  writeTrajectory((root / "groundtruth.txt").string(),
-                  stampedPoses(scene.timestamps, scene.true_cam_from_world));
-  const std::filesystem::path init_poses = root / "init_poses.txt";
-  if (!with_initial_poses) {
-    std::error_code ignored;  // A missing file is what we want.
-    std::filesystem::remove(init_poses, ignored);
-    return;
-  }
-  writeTrajectory(init_poses.string(),
-                  stampedPoses(scene.timestamps, scene.initial_cam_from_world));
+  CURVESFM_CHECK(scene.camera) << "a planar scene needs a camera";
+  SyntheticSequence sequence;
+  sequence.camera = scene.camera.get();
+  sequence.timestamps = &scene.timestamps;
+  sequence.images = scene.images;
+  sequence.true_cam_from_world = &scene.true_cam_from_world;
+  if (with_initial_poses) sequence.initial_cam_from_world = &scene.initial_cam_from_world;
+  writeSyntheticDataset(dir, sequence);
 }
 
 }  // namespace curvesfm

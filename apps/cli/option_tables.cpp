@@ -388,6 +388,10 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
       .nested("local_ba")
       .boolean("local_ba_refines_poses", "local-ba-refine-poses", &o->local_ba_refines_poses,
                "local BA: move the window's poses too (else curves alone)")
+      .number("local_ba_max_curve_keyframes", "local-ba-max-curve-keyframes",
+              &o->local_ba_max_curve_keyframes,
+              "local BA: keyframes per curve segment at most, the window's and the rest spread "
+              "over its track (0: all)")
       .nested("global_ba")
       .boolean("run_global_ba", "run-global-ba", &o->run_global_ba,
                "Run global BA after the last frame")
@@ -534,7 +538,7 @@ void addCurveSceneOptions(OptionsTable* table, CurveSceneOptions* o, const Optio
               "Distance of the cameras from the room centre (m)")
       .number("arc_degrees", "arc", &o->arc_degrees, "orbit: angle spanned by the keyframes (deg)")
       .number("walk_length", "walk-length", &o->walk_length,
-              "forward_walk: distance from the first to the last keyframe (m)")
+              "forward_walk, sideways_walk: distance from the first to the last keyframe (m)")
       .nested("intrinsics")
       .number("num_curves", "curves", &o->num_curves, "3D curves in the room")
       .enumeration("curve_kind", "curve-kind", &o->curve_kind, "Shape of the curves")

@@ -14,6 +14,7 @@
 #include "factors/point_bundle_adjustment.h"
 #include "factors/pose_variables.h"
 #include "frontend/mapping/keyframe_selector.h"
+#include "frontend/mapping/local_ba_observations.h"
 #include "frontend/mapping/nearest_curve_depths.h"
 
 namespace curvesfm {
@@ -29,7 +30,7 @@ struct Keyframe {
   // PipelineFrame::frontend_cam_from_world, in pose units, when given.
   std::optional<Pose3> given_frontend_cam_from_world;
   cv::Mat image_bgr;  // Undistorted.
-  cv::Mat grey;       // Undistorted.
+  cv::Mat grey;  // Undistorted; released once no later keyframe can take it as a depth reference.
   std::shared_ptr<const NearestEdgeField> field;
   std::vector<PointSighting> points;  // The hybrid graph's points it sees.
 };
@@ -253,6 +254,10 @@ void PipelineOptions::validate() const {
   tracking.validate();
   sanity.validate();
   const OptionCheck require("PipelineOptions");
+  require(local_ba_max_curve_keyframes == 0 || local_ba_max_curve_keyframes > local_ba.local_window,
+          "local_ba_max_curve_keyframes", local_ba_max_curve_keyframes,
+          "must be 0 (all) or more than local_ba.local_window (" +
+              std::to_string(local_ba.local_window) + ")");
   require(point_depth_margin >= 1.0 && point_depth_margin < 1e6, "point_depth_margin",
           point_depth_margin, "finite and >= 1");
   require(std::isfinite(scene_scale) && scene_scale >= 0.0, "scene_scale", scene_scale,
@@ -797,6 +802,11 @@ ScheduleReport Pipeline::Impl::bundleAdjust(CurveSelection selection,
   std::vector<int> ids;
   CurveBundleAdjustmentInput input = bundleInput(selection, &ids);
   if (input.observations.empty()) return {};
+  if (scheduler.scope == Scope::kLocal) {
+    input.observations =
+        thinLocalObservations(input.observations, options.local_ba_max_curve_keyframes,
+                              scheduler.local_window, static_cast<int>(keyframes.size()) - 1);
+  }
   const std::vector<int> point_ids = addPointsTo(&input);
   CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options.ba);
   if (!refine_poses) problem.config.setConstant(VariableCategory::kPose);
@@ -883,6 +893,10 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
 
   initialiseCurves(k, unexplainedRuns(chains, explained, options.chains.min_length_px), &stats);
   map.endKeyframe(k);
+  // No later keyframe takes this one as a depth reference: a fifth of a keyframe's memory.
+  if (k >= options.depth_reference_candidates) {
+    keyframes[k - options.depth_reference_candidates].grey.release();
+  }
 
   if (keyframes.size() >= 2 && map.count(CurveState::kGlobal) > 0) {
     const ScheduleReport report = bundleAdjust(CurveSelection::kGlobal, options.local_ba,

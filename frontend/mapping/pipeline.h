@@ -112,6 +112,11 @@ struct PipelineOptions {
   /// LinuxLogo 0 % with a 0.1 deg / 2 mm motion prior: 3.24 -> 6.91 mm moving poses, 2.45 mm
   /// holding them; docs/benchmarks.md).
   bool local_ba_refines_poses = false;
+  /// Local BA refines each curve segment from at most this many of its keyframes: those in the
+  /// window and the rest spread evenly over its older ones (thinLocalObservations). Bounds a
+  /// keyframe's local BA on long sequences, whose curves stay in view over hundreds of
+  /// keyframes; global BA uses every observation. 0: every keyframe; else > local_ba's window.
+  int local_ba_max_curve_keyframes = 0;
   SchedulerOptions global_ba = defaultGlobalBundleAdjustmentOptions();  ///< Once at the end.
   bool run_global_ba = true;   ///< Run global BA in finish().
   /// After global BA, rounds of re-association, each followed by global BA again: every

@@ -1,5 +1,5 @@
-// `curvesfm synth planar` end to end: the real executable, the dataset it writes read back with
-// the dataset readers, its messages and exit codes.
+// `curvesfm synth planar` and `synth curves` end to end: the real executable, the dataset it writes
+// read back with the dataset readers, its messages and exit codes.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "core/curve_map_io.h"
 #include "core/dataset_io.h"
 #include "test/support/run_executable.h"
 
@@ -19,6 +20,23 @@ using ::testing::HasSubstr;
 
 using testing::CommandResult;
 using testing::runCurvesfm;
+
+// What a synth command wrote, read back with the dataset readers.
+struct WrittenDataset {
+  std::vector<ImageEntry> images;
+  std::vector<StampedPose> truth;
+  std::vector<StampedPose> initial;
+  Camera camera;
+
+  bool hasFrames(std::size_t n) const {
+    return images.size() == n && truth.size() == n && initial.size() == n;
+  }
+};
+
+WrittenDataset readWrittenDataset(const std::string& out) {
+  return {readImageList(out + "/rgb.txt"), readTrajectory(out + "/groundtruth.txt"),
+          readTrajectory(out + "/init_poses.txt"), readCameraYaml(out + "/camera.yaml")};
+}
 
 class SynthCommandTest : public ::testing::Test {
  protected:
@@ -55,28 +73,24 @@ TEST_F(SynthCommandTest, WritesAThreeFrameDatasetThatTheReadersReadBack) {
   EXPECT_THAT(result.output, HasSubstr("noise: intensity std dev 12.75 levels"));
   EXPECT_THAT(result.output, HasSubstr("written: " + out));
 
-  const std::vector<ImageEntry> images = readImageList(out + "/rgb.txt");
-  const std::vector<StampedPose> truth = readTrajectory(out + "/groundtruth.txt");
-  const std::vector<StampedPose> initial = readTrajectory(out + "/init_poses.txt");
-  const Camera camera = readCameraYaml(out + "/camera.yaml");
-  ASSERT_EQ(images.size(), 3u);
-  ASSERT_EQ(truth.size(), 3u);
-  ASSERT_EQ(initial.size(), 3u);
-  EXPECT_EQ(camera.width(), 160);
-  EXPECT_EQ(camera.height(), 120);
-  EXPECT_EQ(camera.cx(), 79.5);
-  EXPECT_EQ(camera.fx(), 525.0);
+  const WrittenDataset written = readWrittenDataset(out);
+  ASSERT_TRUE(written.hasFrames(3u));
+  EXPECT_EQ(written.camera.width(), 160);
+  EXPECT_EQ(written.camera.height(), 120);
+  EXPECT_EQ(written.camera.cx(), 79.5);
+  EXPECT_EQ(written.camera.fx(), 525.0);
   for (std::size_t i = 0; i < 3; ++i) {
-    EXPECT_EQ(images[i].timestamp, truth[i].timestamp);
-    EXPECT_EQ(images[i].timestamp, initial[i].timestamp);
-    const cv::Mat image = readColorImage(images[i].path);
+    EXPECT_EQ(written.images[i].timestamp, written.truth[i].timestamp);
+    EXPECT_EQ(written.images[i].timestamp, written.initial[i].timestamp);
+    const cv::Mat image = readColorImage(written.images[i].path);
     EXPECT_EQ(image.cols, 160);
     EXPECT_EQ(image.rows, 120);
     // Camera-to-world: the translation is the camera centre, 0.6 m above the plane.
-    EXPECT_NEAR(truth[i].world_from_cam.translation().z(), 0.6, 1e-9);
-    EXPECT_GT(
-        (initial[i].world_from_cam.translation() - truth[i].world_from_cam.translation()).norm(),
-        0.0);
+    EXPECT_NEAR(written.truth[i].world_from_cam.translation().z(), 0.6, 1e-9);
+    EXPECT_GT((written.initial[i].world_from_cam.translation() -
+               written.truth[i].world_from_cam.translation())
+                  .norm(),
+              0.0);
   }
 }
 
@@ -133,6 +147,38 @@ TEST_F(SynthCommandTest, ConfigFileSuppliesEveryFlagAndTheCommandLineWins) {
   const CommandResult bad = runCurvesfm("synth planar --config " + config);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_THAT(bad.output, HasSubstr(config + ":2: expected a flag of 'curvesfm synth planar'"));
+}
+
+TEST_F(SynthCommandTest, CurvesWritesTheSequenceAndItsTrueCurves) {
+  const std::string out = path("room");
+  const CommandResult result =
+      runCurvesfm("synth curves --out " + out + " --keyframes 4 --curves 5 --seed 3");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("synth curves: 4 frames of 640x480 px"));
+  EXPECT_THAT(result.output, HasSubstr("path: orbit of radius 3.000 m"));
+  EXPECT_THAT(result.output, HasSubstr("curves: 5 (15 segments, mixed)"));
+
+  const WrittenDataset written = readWrittenDataset(out);
+  ASSERT_TRUE(written.hasFrames(4u));
+  EXPECT_EQ(written.camera.intrinsics().k1, -0.05);  // The scene's distortion reaches the reader.
+  EXPECT_EQ(readColorImage(written.images[3].path).cols, 640);
+  // Orbit cameras 3 m from the room centre; the first start pose is the truth (the gauge).
+  EXPECT_NEAR(written.truth[2].world_from_cam.translation().norm(), 3.0, 0.35);
+  EXPECT_EQ(written.initial[0].world_from_cam.translation(),
+            written.truth[0].world_from_cam.translation());
+  EXPECT_GT((written.initial[2].world_from_cam.translation() -
+             written.truth[2].world_from_cam.translation())
+                .norm(),
+            0.0);
+  EXPECT_EQ(readCurveMap(out + "/gt_curves.obj").size(), 5u);
+
+  const CommandResult bad = runCurvesfm("synth curves --out " + out + " --keyframes 1");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_THAT(bad.output, HasSubstr("--keyframes = 1: must be >= 2"));
+  const CommandResult none = runCurvesfm("synth curves --out " + path("bare") +
+                                         " --keyframes 2 --curves 2 --init-poses false");
+  ASSERT_EQ(none.exit_code, 0) << none.output;
+  EXPECT_FALSE(std::filesystem::exists(path("bare") + "/init_poses.txt"));
 }
 
 }  // namespace

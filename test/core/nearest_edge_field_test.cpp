@@ -230,7 +230,7 @@ TEST(NearestEdgeField, CopiesAndMovesKeepTheirLookups) {
   const NearestEdgeField moved = std::move(original);
   for (const NearestEdgeField* field : {&copy, &moved}) {
     EXPECT_EQ(countMismatches(*field, edges, 4), 0);
-    EXPECT_EQ(field->memoryBytes(), 4u * 30u * 20u + sizeof(EdgePixel) * field->edges().size());
+    EXPECT_EQ(field->memoryBytes(), 2u * 30u * 20u + sizeof(EdgePixel) * field->edges().size());
   }
 }
 
@@ -288,12 +288,31 @@ TEST(NearestEdgeField, EmptyImageGivesAnEmptyField) {
   EXPECT_EQ(field.nearest(0.0, 0.0), nullptr);
 }
 
-TEST(NearestEdgeField, MemoryIsFourBytesPerPixelPlusTheEdgeList) {
+TEST(NearestEdgeField, MemoryIsTwoBytesPerPixelPlusTheEdgeList) {
   std::mt19937 rng(3);
   const cv::Mat edges = randomEdges(cv::Size(64, 48), 0.1, rng);
   const NearestEdgeField field = buildWithRandomGradients(edges, 15);
-  EXPECT_EQ(field.memoryBytes(), 4u * 64u * 48u + sizeof(EdgePixel) * field.edges().size());
+  EXPECT_EQ(field.memoryBytes(), 2u * 64u * 48u + sizeof(EdgePixel) * field.edges().size());
   EXPECT_EQ(field.edges().size(), static_cast<std::size_t>(cv::countNonZero(edges)));
+}
+
+TEST(NearestEdgeField, SixtyFiveThousandEdgePixelsTakeFourBytesPerPixelAndStillFindTheirs) {
+  // 65,535 edge pixels: one more than two bytes can index beside the "none" value.
+  cv::Mat edges(256, 256, CV_8UC1, cv::Scalar(255));
+  edges.at<std::uint8_t>(0, 0) = 0;
+  const NearestEdgeField field = buildWithRandomGradients(edges, 2);
+  ASSERT_EQ(field.edges().size(), 65535u);
+  EXPECT_EQ(field.memoryBytes(), 4u * 256u * 256u + sizeof(EdgePixel) * 65535u);
+  EXPECT_EQ(countMismatches(field, edges, 2), 0);
+  const EdgePixel* last = field.nearestToPixel(255, 255);
+  ASSERT_NE(last, nullptr);
+  EXPECT_EQ(last, &field.edges().back());
+
+  edges.at<std::uint8_t>(0, 1) = 0;  // 65,534: two bytes again.
+  const NearestEdgeField narrow = buildWithRandomGradients(edges, 2);
+  EXPECT_EQ(narrow.memoryBytes(), 2u * 256u * 256u + sizeof(EdgePixel) * 65534u);
+  EXPECT_EQ(countMismatches(narrow, edges, 2), 0);
+  EXPECT_EQ(narrow.nearestToPixel(255, 255), &narrow.edges().back());
 }
 
 TEST(NearestEdgeField, NormalsAreUnitGradientDirections) {

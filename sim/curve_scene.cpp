@@ -114,9 +114,13 @@ Pose3 lookAlong(const Eigen::Vector3d& centre, const Eigen::Vector3d& forward) {
 std::vector<Pose3> makeOrbit(const CurveSceneOptions& options) {
   const double arc = options.arc_degrees * kDegToRad;
   const double radius = options.camera_distance;
+  // A full orbit ends one step short of where it began: a last keyframe at the first one's
+  // pose would be a duplicate view, not a loop.
+  const int steps =
+      options.arc_degrees >= 360.0 ? options.num_keyframes : options.num_keyframes - 1;
   std::vector<Pose3> poses;
   for (int i = 0; i < options.num_keyframes; ++i) {
-    const double angle = -0.5 * arc + arc * i / (options.num_keyframes - 1);
+    const double angle = -0.5 * arc + arc * i / steps;
     const Eigen::Vector3d centre(radius * std::sin(angle), -0.1 * radius * std::cos(3.0 * angle),
                                  -radius * std::cos(angle));
     poses.push_back(lookAlong(centre, -centre));

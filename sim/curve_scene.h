@@ -72,7 +72,9 @@ struct CurveSceneOptions {
   /// kOrbit: orbit radius; kForwardWalk: distance from the last keyframe to the room centre;
   /// kSidewaysWalk: distance of the line from the room centre (m); > 0.
   double camera_distance = 3.0;
-  double arc_degrees = 90.0;  ///< kOrbit: angle spanned by the keyframes (deg); (0, 360].
+  /// kOrbit: angle spanned by the keyframes (deg); (0, 360]. At 360 the keyframes are
+  /// 360 / num_keyframes apart, so that the last does not repeat the first.
+  double arc_degrees = 90.0;
   double walk_length = 2.0;   ///< The walks: distance first to last keyframe (m); > 0.
   /// 640x480 pinhole with mild barrel distortion, as PointSceneOptions: rendering and
   /// observations go through the distortion model.

@@ -129,7 +129,8 @@ SynthCommand::SynthCommand(CLI::App* app) : curve_options_(defaultCurveSequenceO
   curves_ = synth->add_subcommand(
       "curves",
       "3D curves (lines, arcs, helices) in a room, rendered as blurred step edges on a grey "
-      "background from cameras on an orbit or a forward walk: the true trajectory, a perturbed "
+      "background from cameras on an orbit, a forward walk or a sideways walk: the true "
+      "trajectory, a perturbed "
       "one as starting guess and the true curves (gt_curves.obj) for eval-map.");
   addConfigFlag(curves_);
   curves_->add_option("--out", out_dir_, "Dataset folder to write (created if needed)")

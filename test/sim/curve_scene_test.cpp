@@ -455,6 +455,44 @@ TEST(CurveScene, BothCameraPathsSeeMostCurves) {
   }
 }
 
+TEST(CurveScene, SidewaysWalkSeesEachCurveOverAStretchOfIt) {
+  CurveSceneOptions options;
+  options.camera_path = CameraPath::kSidewaysWalk;
+  options.num_keyframes = 60;
+  options.walk_length = 30.0;  // 0.5 m between keyframes.
+  options.volume_half_extents = Eigen::Vector3d(14.0, 1.5, 1.0);
+  options.num_curves = 40;
+  const CurveScene scene = makeCurveScene(options);
+  // On the line z = -camera_distance, from x = -15 to 15, looking across it (+z).
+  const Pose3& first = scene.true_cam_from_world.front();
+  const Pose3& last = scene.true_cam_from_world.back();
+  EXPECT_NEAR(first.inverseTranslation().x(), -15.0, 1e-9);
+  EXPECT_NEAR(last.inverseTranslation().x(), 15.0, 1e-9);
+  EXPECT_NEAR(first.inverseTranslation().z(), -3.0, 0.11);
+  EXPECT_GT((first.rotation().conjugate() * Eigen::Vector3d::UnitZ()).z(), 0.99);
+  // A 640 px image at fx 500 spans about 4 m at the curves' 2-4 m depth: nearly every curve is
+  // seen (a long one at 2 m may never fit), each from a bounded stretch of the 60 keyframes,
+  // and nearly every keyframe sees some (the ends of the line look past the volume's ends).
+  std::vector<std::vector<int>> keyframes_of_curve(options.num_curves);
+  std::vector<int> per_keyframe(options.num_keyframes, 0);
+  for (const CurveObservation& observation : scene.observations) {
+    keyframes_of_curve[observation.curve_index].push_back(observation.keyframe_index);
+    ++per_keyframe[observation.keyframe_index];
+  }
+  int seen = 0;
+  for (int c = 0; c < options.num_curves; ++c) {
+    if (keyframes_of_curve[c].empty()) continue;
+    ++seen;
+    const auto [low, high] =
+        std::minmax_element(keyframes_of_curve[c].begin(), keyframes_of_curve[c].end());
+    EXPECT_LT(*high - *low, 20) << "curve " << c;
+  }
+  EXPECT_GE(seen, 0.9 * options.num_curves);
+  const auto seeing =
+      std::count_if(per_keyframe.begin(), per_keyframe.end(), [](int count) { return count > 0; });
+  EXPECT_GE(seeing, 0.9 * options.num_keyframes);
+}
+
 TEST(CurveScene, NoiseKeepsTheEdgesOnTheCurves) {
   CurveSceneOptions options = smallOptions();
   options.pixel_noise = 4.0;

@@ -10,7 +10,6 @@
 
 #include "core/angles.h"
 #include "core/check.h"
-#include "core/dataset_io.h"
 #include "core/errors.h"
 #include "sim/synthetic_dataset.h"
 

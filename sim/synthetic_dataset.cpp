@@ -17,8 +17,7 @@ std::string imageName(std::size_t frame) {
   return name;
 }
 
-}  // namespace
-
+// Creates `folder` and its parents; throws IoError naming it if that fails or a file is there.
 void createDatasetFolder(const std::string& folder) {
   std::error_code error;
   std::filesystem::create_directories(folder, error);
@@ -27,6 +26,8 @@ void createDatasetFolder(const std::string& folder) {
     throw IoError(folder, "cannot create the folder: a file of that name exists");
   }
 }
+
+}  // namespace
 
 void writeSyntheticDataset(const std::string& dir, const SyntheticSequence& sequence) {
   CURVESFM_CHECK(sequence.camera && sequence.timestamps && sequence.true_cam_from_world)

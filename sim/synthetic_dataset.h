@@ -29,7 +29,4 @@ struct SyntheticSequence {
 /// written, CheckError for sizes that do not match.
 void writeSyntheticDataset(const std::string& dir, const SyntheticSequence& sequence);
 
-/// Creates `folder` and its parents; throws IoError naming it if that fails or a file is there.
-void createDatasetFolder(const std::string& folder);
-
 }  // namespace curvesfm

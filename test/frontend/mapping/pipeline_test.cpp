@@ -22,6 +22,18 @@ TEST(PipelineOptions, ValidateNamesTheStageAndField) {
   EXPECT_FALSE(PipelineOptions{}.local_ba_refines_poses);
 }
 
+TEST(PipelineOptions, LocalBaKeyframesPerCurveMustExceedTheWindow) {
+  PipelineOptions options;
+  options.local_ba_max_curve_keyframes = options.local_ba.local_window;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<InvalidOptions>(testing::HasSubstr(
+                  "PipelineOptions.local_ba_max_curve_keyframes = 5: must be 0 (all) or more than "
+                  "local_ba.local_window (5)")));
+  options.local_ba_max_curve_keyframes = 6;
+  EXPECT_NO_THROW(options.validate());
+  EXPECT_EQ(PipelineOptions{}.local_ba_max_curve_keyframes, 0);
+}
+
 TEST(PipelineOptions, ValidateChecksTheReassociationGates) {
   PipelineOptions options;
   options.reassociation_max_edge_distance_px = -1.0;

@@ -173,13 +173,13 @@ void writeCurveStatisticsCsv(const std::string& path, const std::vector<CurveSta
   if (!out) throw IoError(path, "cannot open for writing");
   out << "curve,first_keyframe,keyframes,observations,length,median_camera_distance,"
          "triangulation_angle_deg,residual_rms_px,pose_pull,pose_pull_share,last_keyframe,"
-         "worst_keyframe\n";
+         "worst_keyframe,chord_ratio\n";
   for (std::size_t c = 0; c < stats.size(); ++c) {
     const CurveStatistics& s = stats[c];
     out << c << "," << s.first_keyframe << "," << s.keyframes << "," << s.observations << ","
         << s.length << "," << s.median_camera_distance << "," << s.triangulation_angle_deg << ","
         << s.residual_rms_px << "," << s.pose_pull << "," << s.pose_pull_share << ","
-        << s.last_keyframe << "," << s.worst_keyframe << "\n";
+        << s.last_keyframe << "," << s.worst_keyframe << "," << s.chord_ratio << "\n";
   }
   if (!out) throw IoError(path, "cannot write");
 }
@@ -195,6 +195,7 @@ nlohmann::json worstCurvesJson(const std::vector<CurveStatistics>& stats, CurveR
                      {"worst_keyframe", s.worst_keyframe},
                      {"keyframes", s.keyframes},
                      {"length", s.length},
+                     {"chord_ratio", s.chord_ratio},
                      {"median_camera_distance", s.median_camera_distance},
                      {"triangulation_angle_deg", s.triangulation_angle_deg},
                      {"residual_rms_px", s.residual_rms_px},
@@ -265,6 +266,7 @@ nlohmann::json frameToJson(const KeyframeStats& s) {
         {"frontend", s.frontendSeconds()},
         {"local_ba", s.local_ba_seconds}}},
       {"edge_pixels", s.edge_pixels},
+      {"canny_thresholds", {{"high", s.canny_high_threshold}, {"low", s.canny_low_threshold}}},
       {"chains", s.chains},
       {"valid_depths", s.valid_depths},
       {"registered_segments", s.registered_segments},
@@ -447,6 +449,22 @@ nlohmann::json reassociationToJson(const std::vector<ReassociationRound>& rounds
 
 nlohmann::json vectorToJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
+const char* implausibilityText(CurveImplausibility reason) {
+  switch (reason) {
+    case CurveImplausibility::kOutsideExtent:
+      return "outside the extent";
+    case CurveImplausibility::kLongerThanExtent:
+      return "longer than the extent";
+    case CurveImplausibility::kHighResidual:
+      return "residual above the bound";
+    case CurveImplausibility::kCollapsed:
+      return "collapsed";
+    case CurveImplausibility::kNone:
+      break;
+  }
+  return "plausible";
+}
+
 int countImplausible(const RunSanity& s, CurveImplausibility reason) {
   return static_cast<int>(
       std::count_if(s.implausible_curves.begin(), s.implausible_curves.end(),
@@ -487,7 +505,9 @@ nlohmann::json sanityToJson(const RunSanity& s) {
             {"implausible", s.implausible_curves.size()},
             {"dropped", s.droppedCurves()},
             {"outside_extent", countImplausible(s, CurveImplausibility::kOutsideExtent)},
-            {"longer_than_extent", countImplausible(s, CurveImplausibility::kLongerThanExtent)}}},
+            {"longer_than_extent", countImplausible(s, CurveImplausibility::kLongerThanExtent)},
+            {"high_residual", countImplausible(s, CurveImplausibility::kHighResidual)},
+            {"collapsed", countImplausible(s, CurveImplausibility::kCollapsed)}}},
           {"implausible_curves", curves},
           {"largest_pose_move", move},
           {"verdicts", verdicts}};
@@ -507,10 +527,12 @@ void printSanity(const RunSanity& s) {
   }
   std::printf(
       "; %zu of %d curves of the global map implausible (%d outside the extent, %d longer than "
-      "it), %d dropped",
+      "it, %d of high residual, %d collapsed), %d dropped",
       s.implausible_curves.size(), s.checked_curves,
       countImplausible(s, CurveImplausibility::kOutsideExtent),
-      countImplausible(s, CurveImplausibility::kLongerThanExtent), s.droppedCurves());
+      countImplausible(s, CurveImplausibility::kLongerThanExtent),
+      countImplausible(s, CurveImplausibility::kHighResidual),
+      countImplausible(s, CurveImplausibility::kCollapsed), s.droppedCurves());
   if (s.pose_move.keyframe >= 0) {
     std::printf("; largest pose move %.3g keyframe spacings (keyframe %d)", s.pose_move.spacings(),
                 s.pose_move.keyframe);
@@ -519,11 +541,8 @@ void printSanity(const RunSanity& s) {
   for (std::size_t i = 0; i < s.implausible_curves.size() && i < kListed; ++i) {
     const ImplausibleCurve& c = s.implausible_curves[i];
     std::printf("  curve %d: %d segments, length %.4g, %s, %s after %d global BA%s\n", c.id,
-                c.segments, c.length,
-                c.reason == CurveImplausibility::kOutsideExtent ? "outside the extent"
-                                                                : "longer than the extent",
-                c.dropped ? "dropped" : "kept", c.after_global_bas,
-                c.after_global_bas == 1 ? "" : "s");
+                c.segments, c.length, implausibilityText(c.reason), c.dropped ? "dropped" : "kept",
+                c.after_global_bas, c.after_global_bas == 1 ? "" : "s");
   }
   if (s.implausible_curves.size() > kListed) {
     std::printf("  ... and %zu more (report.json, sanity.implausible_curves)\n",

@@ -95,6 +95,11 @@ CurveSceneOptions defaultCurveSequenceOptions() {
   options.volume_half_extents = Eigen::Vector3d(6.0, 1.5, 6.0);
   options.pose_noise_translation = 0.002;
   options.pose_noise_rotation_deg = 0.1;
+  // `run` detects edges down to 0.8 grey levels / px on noise-free images: a return to the
+  // background of 20 grey levels over 48 px (0.42 / px) shows no second edge beside each curve,
+  // which the unit scene's 40 over 8 px did (half the map of a walk was such ghosts).
+  options.step_contrast = 40.0;
+  options.edge_return_length_px = 48.0;
   return options;
 }
 

@@ -25,12 +25,20 @@ void insertCurve(std::uint32_t c, const PolyBezier& curve, Values* values) {
   }
 }
 
+// `reference_lengths`: E_s1's chord per segment, or empty for the chords of `curve`.
 void addRegularisers(std::uint32_t c, const PolyBezier& curve,
+                     const std::vector<double>& reference_lengths,
                      const CurveBundleAdjustmentOptions& options, FactorGraph* graph) {
+  const bool relative = options.length_sigma_rel > 0.0;
   for (int i = 0; i < curve.numSegments(); ++i) {
     const SegmentKeys keys = segmentKeys(c, i);
-    if (options.lambda1 > 0.0) {
-      const double length = (curve.points()[i + 1] - curve.points()[i]).norm();
+    const double length = reference_lengths.empty()
+                              ? (curve.points()[i + 1] - curve.points()[i]).norm()
+                              : reference_lengths[i];
+    if (relative && length > 0.0) {
+      graph->emplace<SegmentLengthFactor>(keys.q0, keys.q1, length,
+                                          NoiseModel{options.length_sigma_rel * length, {}});
+    } else if (!relative && options.lambda1 > 0.0) {
       graph->emplace<SegmentLengthFactor>(keys.q0, keys.q1, length,
                                           NoiseModel{1.0 / std::sqrt(options.lambda1), {}});
     }
@@ -106,6 +114,7 @@ void CurveBundleAdjustmentOptions::validate() const {
   require.positive("pixel_sigma", pixel_sigma);
   require.positive("kernel_width", kernel_width);
   require.nonNegative("lambda1", lambda1);
+  require.nonNegative("length_sigma_rel", length_sigma_rel);
   require.nonNegative("lambda2", lambda2);
   require.positive("scale_sigma", scale_sigma);
   require.positive("motion_prior_rotation_sigma_deg", motion_prior_rotation_sigma_deg);
@@ -123,9 +132,22 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
   const int num_keyframes = static_cast<int>(input.cam_from_world.size());
   for (int j = 0; j < num_keyframes; ++j)
     problem.values.insert(poseKey(j), input.cam_from_world[j]);
+  const bool given_lengths =
+      options.length_from_creation && !input.segment_reference_lengths.empty();
+  CURVESFM_CHECK(!given_lengths || input.segment_reference_lengths.size() == input.curves.size())
+      << "curve bundle adjustment: reference lengths for " << input.segment_reference_lengths.size()
+      << " curves, " << input.curves.size() << " curves";
   for (std::size_t c = 0; c < input.curves.size(); ++c) {
+    static const std::vector<double> kCurrentChords;
+    const std::vector<double>& lengths =
+        given_lengths ? input.segment_reference_lengths[c] : kCurrentChords;
+    CURVESFM_CHECK(!given_lengths ||
+                   static_cast<int>(lengths.size()) == input.curves[c].numSegments())
+        << "curve bundle adjustment: curve " << c << " has " << input.curves[c].numSegments()
+        << " segments and " << lengths.size() << " reference lengths";
     insertCurve(static_cast<std::uint32_t>(c), input.curves[c], &problem.values);
-    addRegularisers(static_cast<std::uint32_t>(c), input.curves[c], options, &problem.graph);
+    addRegularisers(static_cast<std::uint32_t>(c), input.curves[c], lengths, options,
+                    &problem.graph);
   }
 
   const EdgeBlending blending{options.interpolate_edges, options.interpolate_max_line_offset_px,

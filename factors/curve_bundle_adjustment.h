@@ -53,6 +53,19 @@ struct CurveBundleAdjustmentOptions {
   double kernel_width = 2.0;  ///< Kernel width in sigmas (px at sigma 1); > 0.
   double lambda1 =
       100.0;  ///< Weight of E_s1, segment length (px^2 / length unit^2); >= 0, 0 drops it.
+  /// E_s1's reference: each segment's length when it was created, where the input gives it
+  /// (CurveBundleAdjustmentInput::segment_reference_lengths; the paper's "original value after
+  /// initialization"), instead of its chord at the start of this BA. Off by default: the chord at
+  /// each BA's start lets a segment shrink BA after BA, but with it Pavilion's noise starts ended
+  /// worse (median of 5 seeds 1.24 -> 1.46 x the start; docs/benchmarks.md, "Curves shrink onto
+  /// points").
+  bool length_from_creation = false;
+  /// E_s1 relative to each segment's own length instead: the std dev of its chord is this
+  /// fraction of its reference length (unitless; lambda1 is then unused). A straight segment's
+  /// length is invisible to the edge residuals (they measure across the edge), so without a
+  /// prior of its own size a segment drifts along its edge, in practice shrinking onto a point
+  /// that fits any view. >= 0; 0 uses lambda1.
+  double length_sigma_rel = 0.0;
   double lambda2 = 1.0;  ///< Weight of E_s2, tangent alignment (px^2 / rad^2); >= 0, 0 drops it.
   bool fix_first_pose = true;  ///< Hold keyframe 0 constant (6 of the 7 gauge DoF).
   /// Fix the scale through the distance between keyframes 0 and 1 (a CameraDistanceFactor at
@@ -94,6 +107,11 @@ struct CurveBundleAdjustmentInput {
   std::vector<Pose3> cam_from_world;                            ///< Starting guess per keyframe.
   std::vector<std::shared_ptr<const NearestEdgeField>> fields;  ///< One per keyframe.
   std::vector<PolyBezier> curves;  ///< Starting guess per curve, in world.
+  /// Each segment's chord when it was created, per curve and segment (paper §3.1: "consistent
+  /// with its original value after initialization"): E_s1's reference with
+  /// CurveBundleAdjustmentOptions::length_from_creation, and what CurveStatistics::chord_ratio
+  /// compares with. Empty: the chords of `curves`.
+  std::vector<std::vector<double>> segment_reference_lengths;
   std::vector<SegmentObservation> observations;
   /// Distance between the centres of keyframes 0 and 1 that fixes the scale; <= 0 keeps the
   /// starting distance.

@@ -79,6 +79,17 @@ void residualsOverKeyframes(const std::map<int, SquaredResiduals>& per_keyframe,
   s->residual_rms_px = total.rms();
 }
 
+// Sum of curve c's chords over the sum of its reference lengths (1 without references).
+double chordRatio(const CurveBundleAdjustmentInput& input, std::size_t c) {
+  if (input.segment_reference_lengths.empty()) return 1.0;
+  const std::vector<Eigen::Vector3d>& q = input.curves[c].points();
+  double chords = 0.0;
+  for (std::size_t i = 0; i + 1 < q.size(); ++i) chords += (q[i + 1] - q[i]).norm();
+  double reference = 0.0;
+  for (const double length : input.segment_reference_lengths[c]) reference += length;
+  return reference > 0.0 ? chords / reference : 1.0;
+}
+
 }  // namespace
 
 std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& input,
@@ -96,6 +107,7 @@ std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& i
     s.first_keyframe = keyframes_of[c].empty() ? -1 : *keyframes_of[c].begin();
     s.last_keyframe = keyframes_of[c].empty() ? -1 : *keyframes_of[c].rbegin();
     s.length = arcLength(input.curves[c]);
+    s.chord_ratio = chordRatio(input, c);
     std::vector<Eigen::Vector3d> centres;
     for (int j : keyframes_of[c]) centres.push_back(input.cam_from_world[j].inverseTranslation());
     viewingGeometry(centres, middleOf(input.curves[c]), &s);

@@ -30,6 +30,10 @@ struct CurveStatistics {
   int worst_keyframe = -1;
   double residual_rms_px = 0.0;          ///< RMS of its sample residuals (px).
   double length = 0.0;                   ///< Arc length (the input's length unit).
+  /// Its chords' sum over their references' (CurveBundleAdjustmentInput::
+  /// segment_reference_lengths; 1 without them): below 1 the curve has shrunk since it was made,
+  /// near 0 it has collapsed onto a point of an edge, which fits every view.
+  double chord_ratio = 1.0;
   double median_camera_distance = 0.0;   ///< Observing camera centres to its middle (length unit).
   double triangulation_angle_deg = 0.0;  ///< Widest angle between observing rays at its middle.
   double pose_pull = 0.0;                ///< See above.

@@ -408,18 +408,23 @@ std::vector<std::pair<double, double>> drawnIntervals(const CurveKeyframe& keyfr
 //
 // Each curve adds contrast/2 * side * profile(d) * fade(s) to the background, with d the signed
 // distance (px) to its polyline and s the arc length along it. profile is erf(d / (sqrt(2)
-// sigma)) out to 3 sigma, then returns linearly to 0 over max(8 sigma, 8 px); fade ramps the
-// whole profile linearly over the same length centred on each end, so that no edge appears
-// beyond the ends. Different curves add up; within one curve the nearest piece wins. The work is
-// O(polyline length * band width): every piece visits only the pixels of its own strip, bounded
-// by the bisectors at its ends.
+// sigma)) out to 3 sigma, then returns linearly to 0 over the return length L; fade ramps the
+// whole profile linearly over L at each end, so that no edge appears across or beyond the ends:
+// centred on each end when L is the automatic max(8 sigma, 8 px), inside the curve for a given
+// L (a long, gentle return; the edge then fades out a few px before the end, a subset of the
+// curve, rather than running on past it). Different curves add up; within one curve the nearest
+// piece wins. The work is O(polyline length * band width): every piece visits only the pixels of
+// its own strip, bounded by the bisectors at its ends.
 class StepEdgeRenderer {
  public:
-  StepEdgeRenderer(int width, int height, double sigma, double contrast)
+  StepEdgeRenderer(int width, int height, double sigma, double contrast, double return_length)
       : width_(width),
         height_(height),
         half_contrast_(0.5 * contrast),
-        return_length_(std::max(kReturnLengthPx, kReturnLengthSigmas * sigma)),
+        fade_inside_(return_length > 0.0),
+        fade_length_(fade_inside_ ? return_length
+                                  : std::max(kReturnLengthPx, kReturnLengthSigmas * sigma)),
+        return_length_(fade_length_),
         step_half_width_(kStepHalfWidthSigmas * sigma),
         band_(step_half_width_ + return_length_),
         offset_(static_cast<std::size_t>(width) * height, 0.0f),
@@ -536,8 +541,9 @@ class StepEdgeRenderer {
                       const Eigen::Vector2d& end_normal) {
     // A sliver of overlap between neighbouring strips, so that rounding cannot drop a pixel
     // centre lying on their common bisector.
-    const double before = piece.first ? 0.5 * return_length_ + 1.0 : kStripOverlapPx;
-    const double after = piece.last ? 0.5 * return_length_ + 1.0 : kStripOverlapPx;
+    const double beyond_ends = fade_inside_ ? 0.0 : 0.5 * fade_length_ + 1.0;
+    const double before = piece.first ? beyond_ends : kStripOverlapPx;
+    const double after = piece.last ? beyond_ends : kStripOverlapPx;
     const double reach = band_ + 1.0;
     const Eigen::Vector2d a = piece.start - before * piece.direction;
     const Eigen::Vector2d b = piece.start + (piece.length + after) * piece.direction;
@@ -620,16 +626,18 @@ class StepEdgeRenderer {
   }
 
   double fade(double along, double total) const {
-    const double half = 0.5 * return_length_;
-    const double from_start = std::clamp((along + half) / return_length_, 0.0, 1.0);
-    const double from_end = std::clamp((total - along + half) / return_length_, 0.0, 1.0);
+    const double half = fade_inside_ ? 0.0 : 0.5 * fade_length_;
+    const double from_start = std::clamp((along + half) / fade_length_, 0.0, 1.0);
+    const double from_end = std::clamp((total - along + half) / fade_length_, 0.0, 1.0);
     return from_start * from_end;
   }
 
   int width_;
   int height_;
   double half_contrast_;
-  double return_length_;
+  bool fade_inside_;      // The fade ends at the polyline's ends rather than straddling them.
+  double fade_length_;    // Of the fade at each end (px).
+  double return_length_;  // Of the return to the background beside the curve (px).
   double step_half_width_;
   double band_;
   std::vector<float> profile_;    // profile(r) at r = k * kProfileTableStepPx.
@@ -742,7 +750,7 @@ void renderKeyframe(const CurveScene& scene, const CurveSceneOptions& options, i
                     CurveKeyframe* keyframe) {
   const Camera& camera = *scene.camera;
   StepEdgeRenderer renderer(camera.width(), camera.height(), options.edge_blur_sigma_px,
-                            options.step_contrast);
+                            options.step_contrast, options.edge_return_length_px);
   for (int c = 0; c < static_cast<int>(scene.true_curves.size()); ++c) {
     const PolyBezier& curve = scene.true_curves[c];
     for (const auto& [g0, g1] : drawnIntervals(*keyframe, c, curve.numSegments())) {
@@ -839,6 +847,8 @@ void CurveSceneOptions::validate() const {
           "must be in [0.3, 5]");
   require(step_contrast > 0.0 && step_contrast <= 255.0, "step_contrast", step_contrast,
           "must be in (0, 255]");
+  require(edge_return_length_px == 0.0 || inRange(edge_return_length_px, 1.0, 200.0),
+          "edge_return_length_px", edge_return_length_px, "must be 0 or in [1, 200]");
   require(pixel_noise >= 0.0 && std::isfinite(pixel_noise), "pixel_noise", pixel_noise,
           "must be finite and >= 0");
   require(canny_low_threshold > 0.0 && std::isfinite(canny_low_threshold), "canny_low_threshold",

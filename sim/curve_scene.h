@@ -98,8 +98,16 @@ struct CurveSceneOptions {
   // --- rendering ---
   /// Gaussian blur of the step edges (px); in [0.3, 5]. The band drawn on each side of a curve
   /// is the erf step out to 3 sigma, then a linear return to the background over
-  /// max(8 sigma, 8 px), slow enough for Canny to ignore.
+  /// edge_return_length_px, slow enough for this scene's Canny thresholds to ignore.
   double edge_blur_sigma_px = 1.0;
+  /// Length of that return (px); 0 = max(8 sigma, 8 px), else in [1, 200]. Its slope,
+  /// contrast / (2 * length) grey levels per px, must stay below the low threshold of whatever
+  /// detector reads the images, or each curve shows a second, parallel edge a few pixels away:
+  /// `curvesfm run`'s automatic thresholds fall to 0.8 grey levels / px on noise-free images
+  /// (EdgeDetectorOptions::auto_min_high_threshold x auto_low_ratio), 5 for the defaults here.
+  /// A given length also fades each curve's ends out over it inside the curve, so that the fade
+  /// draws no edge across the end nor continues the edge past it.
+  double edge_return_length_px = 0.0;
   /// Intensity step across an edge (8-bit units): the bright side is background + contrast / 2,
   /// the dark side background - contrast / 2 (background 128); in (0, 255]. The peak L2 Sobel
   /// magnitude of a straight edge is about 4 * contrast * erf(1 / (sqrt(2) sigma)), 218 for the

@@ -306,6 +306,12 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
       .number("lambda1", "lambda1", &b->lambda1,
               "Weight of the segment-length term (px^2 per squared length unit: scene scale in "
               "run, scene unit in curve-ba); 0 drops it")
+      .boolean("length_from_creation", "length-from-creation", &b->length_from_creation,
+               "Segment-length term against each segment's length at creation (else its chord "
+               "when each BA starts)")
+      .number("length_sigma_rel", "length-sigma-rel", &b->length_sigma_rel,
+              "Segment-length term relative to each segment instead: std dev of its chord as a "
+              "fraction of its length at creation (0: lambda1)")
       .number("lambda2", "lambda2", &b->lambda2,
               "Weight of the tangent term (px^2/rad^2); 0 drops it")
       .boolean("fix_first_pose", "fix-first-pose", &b->fix_first_pose,
@@ -359,6 +365,12 @@ void addSanityOptions(OptionsTable* table, SanityOptions* o, const OptionPlace& 
               "Enlarge the extent on every side by this fraction of its diagonal")
       .number("samples_per_segment", "samples-per-segment", &o->samples_per_segment,
               "Samples per segment checked against the extent")
+      .number("max_curve_residual_px", "max-curve-residual", &o->max_curve_residual_px,
+              "After each global BA, a curve whose residual RMS exceeds this is implausible too "
+              "(px; 0: off)")
+      .number("min_chord_ratio", "min-chord-ratio", &o->min_chord_ratio,
+              "After each global BA, a curve whose chords shrank below this fraction of their "
+              "lengths at creation is implausible too (0: off)")
       .number("max_implausible_fraction", "max-implausible-fraction", &o->max_implausible_fraction,
               "Verdict when more than this fraction of the global map's curves is implausible")
       .number("max_pose_move_spacings", "max-pose-move", &o->max_pose_move_spacings,
@@ -557,6 +569,9 @@ void addCurveSceneOptions(OptionsTable* table, CurveSceneOptions* o, const Optio
               "Least distance of a curve point from every camera centre (m)")
       .number("edge_blur_sigma_px", "edge-blur-sigma", &o->edge_blur_sigma_px,
               "Blur of the rendered step edges (px)")
+      .number("edge_return_length_px", "edge-return-length", &o->edge_return_length_px,
+              "Length of the linear return to the background beside a rendered edge (px); 0: "
+              "max(8 sigma, 8 px)")
       .number("step_contrast", "step-contrast", &o->step_contrast,
               "Intensity step across a rendered edge (8-bit units)")
       .number("pixel_noise", "image-noise", &o->pixel_noise,

@@ -77,8 +77,21 @@ std::vector<int> CurveMap::curvesIn(CurveState state) const {
   return ids;
 }
 
+namespace {
+
+// Segments without observations, with the chords of `curve`'s segments [first, first + count).
+std::vector<MapSegment> newSegments(const PolyBezier& curve, int first, int count) {
+  std::vector<MapSegment> segments(count);
+  for (int i = 0; i < count; ++i) {
+    segments[i].initial_chord = (curve.points()[first + i + 1] - curve.points()[first + i]).norm();
+  }
+  return segments;
+}
+
+}  // namespace
+
 int CurveMap::addCurve(const PolyBezier& curve, int keyframe) {
-  curves_.push_back(MapCurve{curve, std::vector<MapSegment>(curve.numSegments()),
+  curves_.push_back(MapCurve{curve, newSegments(curve, 0, curve.numSegments()),
                              CurveState::kTemporary, false, keyframe});
   return size() - 1;
 }
@@ -111,8 +124,11 @@ void CurveMap::extendCurve(int id, const PolyBezier& extended, CurveEnd end) {
   const int added = extended.numSegments() - c.curve.numSegments();
   CURVESFM_CHECK(added > 0) << "extending curve " << id << " of " << c.curve.numSegments()
                             << " segments to " << extended.numSegments() << " segments";
-  const auto at = end == CurveEnd::kFront ? c.segments.begin() : c.segments.end();
-  c.segments.insert(at, added, MapSegment());
+  const bool front = end == CurveEnd::kFront;
+  const std::vector<MapSegment> segments =
+      newSegments(extended, front ? 0 : c.curve.numSegments(), added);
+  c.segments.insert(front ? c.segments.begin() : c.segments.end(), segments.begin(),
+                    segments.end());
   c.curve = extended;
   if (end == CurveEnd::kBack) return;
   for (int i = added; i < c.curve.numSegments(); ++i) {
@@ -161,6 +177,8 @@ ExportedCurves CurveMap::exportCurves(CurveSelection selection) const {
     const int index = static_cast<int>(exported.ids.size());
     exported.ids.push_back(id);
     exported.curves.push_back(c.curve);
+    std::vector<double>& chords = exported.initial_chords.emplace_back();
+    for (const MapSegment& s : c.segments) chords.push_back(s.initial_chord);
     for (int i = 0; i < c.curve.numSegments(); ++i) {
       for (const ObservedSegmentAppearance& o : c.segments[i].observations) {
         exported.observations.push_back({index, i, o.observation.keyframe});

@@ -66,6 +66,10 @@ struct MapSegment {
   /// Verified observations in increasing keyframe order, at most one per keyframe.
   std::vector<ObservedSegmentAppearance> observations;
   ViewingDirectionMean viewing;  ///< Over all observations.
+  /// Chord |Q_{i+1} - Q_i| when the segment was created (curve initialisation or extension):
+  /// the segment-length regulariser's reference in every bundle adjustment, so that the curve
+  /// cannot shrink by a little in each of them.
+  double initial_chord = 0.0;
 
   /// The reference for the next check: the first observation's appearance (the paper stores
   /// the colour of the original observation) and the mean viewing direction.
@@ -96,6 +100,8 @@ struct MapCurve {
 struct ExportedCurves {
   std::vector<int> ids;            ///< Map id of each exported curve, increasing.
   std::vector<PolyBezier> curves;  ///< World frame.
+  /// MapSegment::initial_chord per curve and segment.
+  std::vector<std::vector<double>> initial_chords;
   std::vector<SegmentObservation> observations;
 };
 

@@ -340,6 +340,7 @@ struct Pipeline::Impl {
                            const std::vector<int>& reference_keyframes);
   CurveBundleAdjustmentInput bundleInput(CurveSelection selection, std::vector<int>* ids) const;
   std::vector<int> addPointsTo(CurveBundleAdjustmentInput* input) const;
+  void checkFit(bool drop);
   ScheduleReport bundleAdjust(CurveSelection selection, const SchedulerOptions& scheduler,
                               bool refine_poses, CurveSampleCounts* samples);
   SceneExtent currentExtent() const;
@@ -407,6 +408,8 @@ cv::Mat Pipeline::Impl::prepareKeyframe(const PipelineFrame& frame, std::vector<
   *chains = extractEdgeChains(edges, options.chains);
   stats->edges_seconds = secondsSince(start);
   stats->edge_pixels = cv::countNonZero(edges.edges);
+  stats->canny_high_threshold = edges.high_threshold;
+  stats->canny_low_threshold = edges.low_threshold;
   stats->chains = static_cast<int>(chains->size());
 
   start = Clock::now();
@@ -769,6 +772,7 @@ CurveBundleAdjustmentInput Pipeline::Impl::bundleInput(CurveSelection selection,
                                               keyframes[0].initial_cam_from_world);
   ExportedCurves exported = map.exportCurves(selection);
   input.curves = std::move(exported.curves);
+  input.segment_reference_lengths = std::move(exported.initial_chords);
   input.observations = std::move(exported.observations);
   *ids = std::move(exported.ids);
   return input;
@@ -859,6 +863,32 @@ void Pipeline::Impl::checkCurves(bool drop) {
     implausible.push_back({promoted.ids[i], promoted.curves[i].numSegments(), check.length * unit(),
                            check.reason, global_bas, drop});
     if (drop) map.dropImplausible(promoted.ids[i]);
+  }
+  const bool fit_checks =
+      options.sanity.max_curve_residual_px > 0.0 || options.sanity.min_chord_ratio > 0.0;
+  if (fit_checks && global_bas > 0) checkFit(drop);
+}
+
+// Judges every curve still in the map by how it fits its views after a global BA: its residual
+// RMS (SanityOptions::max_curve_residual_px) and its chord ratio (min_chord_ratio).
+void Pipeline::Impl::checkFit(bool drop) {
+  const SanityOptions& sanity = options.sanity;
+  std::vector<int> ids;
+  const CurveBundleAdjustmentInput input = bundleInput(CurveSelection::kPromoted, &ids);
+  const std::vector<CurveStatistics> stats = curveStatistics(input, options.ba);
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    CurveImplausibility reason = CurveImplausibility::kNone;
+    if (sanity.max_curve_residual_px > 0.0 &&
+        stats[i].residual_rms_px > sanity.max_curve_residual_px) {
+      reason = CurveImplausibility::kHighResidual;
+    } else if (stats[i].chord_ratio < sanity.min_chord_ratio) {
+      reason = CurveImplausibility::kCollapsed;
+    }
+    if (reason == CurveImplausibility::kNone) continue;
+    const CurveCheck check = checkCurve(input.curves[i], extent, sanity.samples_per_segment);
+    implausible.push_back(
+        {ids[i], input.curves[i].numSegments(), check.length * unit(), reason, global_bas, drop});
+    if (drop) map.dropImplausible(ids[i]);
   }
 }
 

@@ -220,6 +220,9 @@ struct KeyframeStats {
   double local_ba_seconds = 0.0;
   // Counts.
   int edge_pixels = 0;
+  /// Canny hysteresis thresholds applied to this keyframe (grey levels / px), automatic or given.
+  double canny_high_threshold = 0.0;
+  double canny_low_threshold = 0.0;
   int chains = 0;
   int valid_depths = 0;
   int registered_segments = 0;  ///< Map segments registered in this keyframe.

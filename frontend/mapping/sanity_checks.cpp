@@ -18,6 +18,10 @@ void SanityOptions::validate() const {
   require.nonNegative("extent_margin", extent_margin);
   require(samples_per_segment >= 1 && samples_per_segment <= 1000, "samples_per_segment",
           samples_per_segment, "in [1, 1000]");
+  require(max_curve_residual_px >= 0.0 && std::isfinite(max_curve_residual_px),
+          "max_curve_residual_px", max_curve_residual_px, "finite and >= 0");
+  require(min_chord_ratio >= 0.0 && min_chord_ratio < 1.0, "min_chord_ratio", min_chord_ratio,
+          "in [0, 1)");
   require(max_implausible_fraction >= 0.0 && max_implausible_fraction <= 1.0,
           "max_implausible_fraction", max_implausible_fraction, "in [0, 1]");
   require.positive("max_pose_move_spacings", max_pose_move_spacings);
@@ -166,7 +170,8 @@ std::vector<RunVerdict> judgeRun(int keyframes, int curves, int checked, int imp
     m << implausible << " of " << checked << " curves that reached the global map ("
       << 100.0 * implausible / checked << " %, more than "
       << 100.0 * options.max_implausible_fraction
-      << " %) left the scene's extent or were longer than it: the map is unreliable";
+      << " %) were implausible (outside the scene's extent, longer than it, or not fitting their "
+         "views): the map is unreliable";
     add(RunVerdictKind::kMostCurvesImplausible, m);
   }
   if (move.keyframe >= 0 && move.spacings() > options.max_pose_move_spacings) {

@@ -37,6 +37,14 @@ struct SanityOptions {
   /// Samples per curve segment tested against the extent and summed into the curve's length
   /// (count). In [1, 1000].
   int samples_per_segment = 8;
+  /// After each global BA, a curve whose residual RMS over all its observations exceeds this
+  /// (px) is implausible too (dropped with drop_implausible_curves): a curve lifted from a wrong
+  /// match, or an occluding contour, fits no set of poses, and left in the map it pulls them
+  /// towards its own error. A capped sample counts at the cap (CurveStatistics). >= 0; 0 off.
+  double max_curve_residual_px = 0.0;
+  /// After each global BA, a curve whose chords sum to less than this fraction of their lengths
+  /// at creation (CurveStatistics::chord_ratio) is implausible too. In [0, 1); 0 off.
+  double min_chord_ratio = 0.0;
   /// Verdict when more than this fraction of the curves that reached the global map were
   /// implausible (unitless). In [0, 1].
   double max_implausible_fraction = 0.5;
@@ -85,14 +93,22 @@ enum class CurveImplausibility {
   kNone,              ///< Plausible.
   kOutsideExtent,     ///< A sample lies outside the scene's extent.
   kLongerThanExtent,  ///< Inside, but longer than the extent's diagonal.
+  /// Its residual RMS over its observations exceeds SanityOptions::max_curve_residual_px after a
+  /// global BA: it does not fit its own views.
+  kHighResidual,
+  /// Its chords sum to less than SanityOptions::min_chord_ratio of their lengths at creation
+  /// after a global BA: it has collapsed towards a point of an edge, which fits any view.
+  kCollapsed,
 };
 
 template <>
 struct EnumNames<CurveImplausibility> {
-  static constexpr std::array<std::pair<CurveImplausibility, const char*>, 3> kNames = {{
+  static constexpr std::array<std::pair<CurveImplausibility, const char*>, 5> kNames = {{
       {CurveImplausibility::kNone, "none"},
       {CurveImplausibility::kOutsideExtent, "outside_extent"},
       {CurveImplausibility::kLongerThanExtent, "longer_than_extent"},
+      {CurveImplausibility::kHighResidual, "high_residual"},
+      {CurveImplausibility::kCollapsed, "collapsed"},
   }};
 };
 

@@ -129,5 +129,31 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_TRUE(std::filesystem::exists(path("again") + "/overlays/000005.png"));
 }
 
+// The fit checks after global BA: with a residual bound no curve meets, every curve of the global
+// map is found implausible for its residual, dropped and counted under its reason, and a run
+// left with nothing plausible says so and fails.
+TEST_F(RunCommandTest, FitChecksDropCurvesThatDoNotFitTheirViews) {
+  const std::string dataset = writeShortPlanarDataset();
+  const std::string out = path("fit_out");
+  const CommandResult result =
+      runCurvesfm("run --dataset " + dataset + " --out " + out + shortPlanarFlags() +
+                  " --sanity-max-curve-residual 0.001 --sanity-min-chord-ratio 0.5");
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("was implausible and dropped: nothing plausible"));
+  std::ifstream report_file(out + "/report.json");
+  const nlohmann::json report = nlohmann::json::parse(report_file);
+  const nlohmann::json& counts = report["sanity"]["counts"];
+  EXPECT_GT(counts["checked"].get<int>(), 0);
+  EXPECT_EQ(counts["high_residual"].get<int>() + counts["collapsed"].get<int>(),
+            counts["checked"].get<int>());
+  EXPECT_GT(counts["high_residual"].get<int>(), 0);
+  EXPECT_EQ(counts["dropped"], counts["checked"]);
+  EXPECT_EQ(report["counts"]["curves"], 0);
+  EXPECT_EQ(report["options"]["pipeline"]["sanity"]["max_curve_residual_px"], 0.001);
+  EXPECT_THAT(result.output, HasSubstr(" of high residual, "));
+  EXPECT_THAT(result.output, HasSubstr(", residual above the bound, dropped after 1 global BA"));
+  EXPECT_THAT(result.output, HasSubstr("were implausible (outside the scene's extent"));
+}
+
 }  // namespace
 }  // namespace curvesfm

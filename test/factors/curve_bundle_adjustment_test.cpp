@@ -62,6 +62,52 @@ TEST(CurveBundleAdjustment, HybridGraphKeepsPointsBesideCurvesWithTheirOwnNoise)
   EXPECT_THROW(buildCurveBundleAdjustment(input, hybrid), CheckError);
 }
 
+// With length_from_creation, E_s1 measures each segment against the reference it is given (its
+// chord at creation), not its current chord, absolutely (lambda1) or relative to that reference
+// (length_sigma_rel); without it, against the chord it starts from.
+TEST(CurveBundleAdjustment, SegmentLengthTermUsesTheGivenReferences) {
+  CurveSceneOptions scene_options;
+  scene_options.num_keyframes = 2;
+  const CurveScene scene = makeCurveScene(scene_options);
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  input.curves.erase(input.curves.begin() + 1, input.curves.end());
+  input.observations.clear();  // The regulariser needs none.
+  const PolyBezier& curve = input.curves[0];
+  std::vector<double> chords;
+  for (int i = 0; i < curve.numSegments(); ++i) {
+    chords.push_back((curve.points()[i + 1] - curve.points()[i]).norm());
+  }
+  auto lengthCost = [&input](const CurveBundleAdjustmentOptions& options) {
+    const CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options);
+    return problem.graph.costByType(problem.values).at("segment_length").cost;
+  };
+  CurveBundleAdjustmentOptions absolute;
+  absolute.lambda1 = 4.0;  // sigma 0.5
+  EXPECT_NEAR(lengthCost(absolute), 0.0, 1e-12);
+  // References 20 % longer than the chords: each segment is 0.2 chord short.
+  input.segment_reference_lengths = {chords};
+  double expected_absolute = 0.0;
+  double expected_relative = 0.0;
+  for (double& reference : input.segment_reference_lengths[0]) {
+    const double chord = reference;
+    reference *= 1.2;
+    expected_absolute += 0.5 * std::pow((0.2 * chord) / 0.5, 2);
+    expected_relative += 0.5 * std::pow((0.2 * chord) / (0.1 * reference), 2);
+  }
+  EXPECT_NEAR(lengthCost(absolute), 0.0, 1e-12);
+  absolute.length_from_creation = true;
+  EXPECT_NEAR(lengthCost(absolute), expected_absolute, 1e-9);
+  CurveBundleAdjustmentOptions relative;
+  relative.length_sigma_rel = 0.1;
+  relative.length_from_creation = true;
+  EXPECT_NEAR(lengthCost(relative), expected_relative, 1e-9);
+  input.segment_reference_lengths[0].pop_back();
+  EXPECT_THROW(buildCurveBundleAdjustment(input, absolute), CheckError);
+  input.segment_reference_lengths.clear();
+  input.segment_reference_lengths.resize(2);
+  EXPECT_THROW(buildCurveBundleAdjustment(input, absolute), CheckError);
+}
+
 // The motion prior's cost when keyframe 2 of a trajectory scaled by `scale` is moved by
 // scale * 1 mm off it.
 double motionPriorCost(const CurveScene& scene, double scale) {
@@ -104,6 +150,9 @@ TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
   options = {};
   options.lambda1 = -1.0;
   expectRejected(options, "lambda1");
+  options = {};
+  options.length_sigma_rel = -0.1;
+  expectRejected(options, "length_sigma_rel");
   options = {};
   options.interpolate_max_line_offset_px = -0.1;
   expectRejected(options, "interpolate_max_line_offset_px");

@@ -90,6 +90,12 @@ TEST(CurveSceneOptions, RejectionNamesFieldValueAndConstraint) {
   options.edge_blur_sigma_px = 0.0;
   EXPECT_NE(validationMessage(options).find("edge_blur_sigma_px"), std::string::npos);
   options = CurveSceneOptions();
+  options.edge_return_length_px = 0.5;
+  EXPECT_NE(
+      validationMessage(options).find("edge_return_length_px = 0.5: must be 0 or in [1, 200]"),
+      std::string::npos)
+      << validationMessage(options);
+  options = CurveSceneOptions();
   options.curve_point_noise = -0.1;
   EXPECT_NE(validationMessage(options).find("curve_point_noise = -0.1"), std::string::npos);
   options = CurveSceneOptions();

@@ -182,6 +182,45 @@ TEST(CurveMap, ExtendingAtTheFrontMovesObservationsWithTheirSegments) {
   EXPECT_EQ(c.segments[4].observations[0].observation.segment, 4);
 }
 
+// Each segment keeps the chord it was created with (E_s1's reference), through geometry updates
+// and extensions at either end, so that bundle adjustments cannot shrink it step by step.
+TEST(CurveMap, SegmentsKeepTheirChordsAtCreation) {
+  CurveMap map;
+  const int id = map.addCurve(straightCurve(2), 0);
+  PolyBezier shrunk = straightCurve(2);
+  shrunk.setPoint(1, Eigen::Vector3d(0.02, 0.0, 1.0));
+  map.updateCurves({id}, {shrunk});
+  // Extensions whose new segments are longer than the old ones (0.3 instead of 0.1).
+  auto extendedBy = [](const PolyBezier& curve, int added, bool front) {
+    std::vector<Eigen::Vector3d> points = curve.points();
+    for (int k = 1; k <= added; ++k) {
+      const Eigen::Vector3d end = front ? points.front() : points.back();
+      const Eigen::Vector3d step(front ? -0.3 : 0.3, 0.0, 0.0);
+      if (front) {
+        points.insert(points.begin(), end + step);
+      } else {
+        points.push_back(end + step);
+      }
+    }
+    std::vector<Direction> directions(points.size(), Direction(Eigen::Vector3d::UnitX()));
+    return PolyBezier(points, directions,
+                      std::vector<SegmentLengths>(points.size() - 1, {0.03, 0.03}));
+  };
+  map.extendCurve(id, extendedBy(map.curve(id).curve, 1, false), CurveEnd::kBack);
+  map.extendCurve(id, extendedBy(map.curve(id).curve, 2, true), CurveEnd::kFront);
+  std::vector<double> chords;
+  for (const MapSegment& s : map.curve(id).segments) chords.push_back(s.initial_chord);
+  EXPECT_THAT(chords, testing::Pointwise(testing::DoubleNear(1e-12),
+                                         std::vector<double>{0.3, 0.3, 0.1, 0.1, 0.3}));
+  for (int k = 0; k < 3; ++k) {
+    observeSegments(&map, id, 0, 4, k);
+    map.endKeyframe(k);
+  }
+  const ExportedCurves exported = map.exportCurves(CurveSelection::kGlobal);
+  ASSERT_EQ(exported.initial_chords.size(), 1u);
+  EXPECT_THAT(exported.initial_chords[0], testing::Pointwise(testing::DoubleNear(1e-12), chords));
+}
+
 // A dropped curve leaves every export and stays dropped, whatever the keyframes see.
 TEST(CurveMap, DroppedCurveLeavesEveryExportForGood) {
   CurveMap map;

@@ -173,6 +173,16 @@ TEST(SanityOptions, ValidateNamesTheField) {
   options = {};
   options.extent_percentile = 30.0;
   EXPECT_THROW(options.validate(), InvalidOptions);
+  options = {};
+  options.max_curve_residual_px = -1.0;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<InvalidOptions>(
+                  testing::HasSubstr("SanityOptions.max_curve_residual_px")));
+  options = {};
+  options.min_chord_ratio = 1.0;
+  EXPECT_THAT(
+      [&] { options.validate(); },
+      testing::ThrowsMessage<InvalidOptions>(testing::HasSubstr("SanityOptions.min_chord_ratio")));
 }
 
 }  // namespace

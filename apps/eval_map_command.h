@@ -43,6 +43,7 @@ class EvalMapCommand {
   std::string ground_truth_trajectory_path_;
   std::string ground_truth_curves_path_;
   std::string json_path_;
+  bool align_frames_ = true;
   ImageSequenceOptions sequence_;
   TrajectoryEvaluationOptions alignment_;
   CurveMapEvaluationOptions options_;

@@ -26,10 +26,11 @@ constexpr double kScale = 0.5;
 
 class EvalMapCommandTest : public testing::TempFolderTest {
  protected:
+  static Eigen::Matrix3d rotation() {
+    return Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).matrix();
+  }
   static Eigen::Vector3d toEstimate(const Eigen::Vector3d& gt) {
-    const Eigen::Matrix3d r =
-        Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).matrix();
-    return kScale * (r.transpose() * (gt - Eigen::Vector3d(0.3, -1.0, 2.0)));
+    return kScale * (rotation().transpose() * (gt - Eigen::Vector3d(0.3, -1.0, 2.0)));
   }
   // The ground-truth curves: a circle of radius 1 in the plane z = 0 as 100 edges of a curve
   // graph (Pavilion's format).
@@ -62,13 +63,23 @@ class EvalMapCommandTest : public testing::TempFolderTest {
     for (int k = 0; k <= 100; ++k) text += " " + std::to_string(k % 100 + 1);
     write(name, text + "\n");
   }
-  // A wavy orbit of 20 camera centres around the circle, 1 s apart, TUM camera-to-world.
-  void writeTrajectory(const std::string& name, bool in_estimate_frame) const {
+  // 20 cameras 1 s apart, TUM camera-to-world: a wavy orbit around the circle, or a straight
+  // walk past it, each camera turned a little about its own axes.
+  void writeTrajectory(const std::string& name, bool in_estimate_frame,
+                       bool straight = false) const {
     std::string text;
     for (int k = 0; k < 20; ++k) {
       const double a = 0.3 * k;
-      const Eigen::Vector3d c(3.0 * std::cos(a), 3.0 * std::sin(a), 1.0 + 0.2 * std::sin(3 * a));
-      text += std::to_string(k) + " " + xyz(in_estimate_frame ? toEstimate(c) : c) + " 0 0 0 1\n";
+      const Eigen::Vector3d c = straight ? Eigen::Vector3d(-2.0 + 0.2 * k, -3.0, 0.5)
+                                         : Eigen::Vector3d(3.0 * std::cos(a), 3.0 * std::sin(a),
+                                                           1.0 + 0.2 * std::sin(3 * a));
+      Eigen::Matrix3d world_from_cam =
+          Eigen::AngleAxisd(0.1 * std::sin(a), Eigen::Vector3d(0.3, 1.0, 0.2).normalized())
+              .matrix();
+      if (in_estimate_frame) world_from_cam = rotation().transpose() * world_from_cam;
+      const Eigen::Quaterniond q(world_from_cam);
+      text += std::to_string(k) + " " + xyz(in_estimate_frame ? toEstimate(c) : c) + " " +
+              xyz(q.vec()) + " " + std::to_string(q.w()) + "\n";
     }
     write(name, text);
   }
@@ -112,6 +123,25 @@ TEST_F(EvalMapCommandTest, AlignsTheRunByItsTrajectoryAndScoresTheGroundTruthAsO
   EXPECT_EQ(report["options"]["alignment"]["alignment"], "sim3");
   EXPECT_EQ(report["inputs"]["ground_truth_format"], "curve_graph");
   EXPECT_EQ(report["estimate"]["samples"], report["ground_truth"]["samples"]);
+}
+
+// Camera centres on one line leave the rotation about it free: fitted to the centres alone the
+// curves land anywhere around the line, fitted to the camera frames (the default) on the truth.
+TEST_F(EvalMapCommandTest, AStraightTrajectoryIsAlignedByItsCameraFrames) {
+  writeGroundTruthCurves();
+  writeEstimatedCurves("run/curves.obj", Eigen::Vector3d::Zero(), true);
+  writeTrajectory("run/trajectory.txt", true, /*straight=*/true);
+  writeTrajectory("gt.txt", false, /*straight=*/true);
+  auto precisionAt1cm = [&](const std::string& flags) {
+    const CommandResult result =
+        runCurvesfm("eval-map --run " + path("run") + " --gt-trajectory " + path("gt.txt") +
+                    " --gt-curves " + path("gt") + " --json " + path("map.json") + flags);
+    EXPECT_EQ(result.exit_code, 0) << result.output;
+    return readJson("map.json")["scores"][0]["precision"].get<double>();
+  };
+  EXPECT_LT(precisionAt1cm(" --align-frames false"), 0.5);
+  EXPECT_DOUBLE_EQ(precisionAt1cm(""), 1.0);
+  EXPECT_GT(readJson("map.json")["alignment"]["frames_axis_length"].get<double>(), 1.0);
 }
 
 TEST_F(EvalMapCommandTest, AlignNoneTakesTheCurvesAsTheyAreAndConfigSetsTheTaus) {

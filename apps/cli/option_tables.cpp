@@ -311,7 +311,7 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
                "when each BA starts)")
       .number("length_sigma_rel", "length-sigma-rel", &b->length_sigma_rel,
               "Segment-length term relative to each segment instead: std dev of its chord as a "
-              "fraction of its length at creation (0: lambda1)")
+              "fraction of its reference length (0: lambda1)")
       .number("lambda2", "lambda2", &b->lambda2,
               "Weight of the tangent term (px^2/rad^2); 0 drops it")
       .boolean("fix_first_pose", "fix-first-pose", &b->fix_first_pose,

@@ -67,8 +67,8 @@ struct MapSegment {
   std::vector<ObservedSegmentAppearance> observations;
   ViewingDirectionMean viewing;  ///< Over all observations.
   /// Chord |Q_{i+1} - Q_i| when the segment was created (curve initialisation or extension):
-  /// the segment-length regulariser's reference in every bundle adjustment, so that the curve
-  /// cannot shrink by a little in each of them.
+  /// the segment-length regulariser's reference with
+  /// CurveBundleAdjustmentOptions::length_from_creation, and the base of the chord ratio.
   double initial_chord = 0.0;
 
   /// The reference for the next check: the first observation's appearance (the paper stores

@@ -850,19 +850,21 @@ SceneExtent Pipeline::Impl::currentExtent() const {
   return sceneExtent(centres, scene, "curves", options.sanity);
 }
 
-// Judges every curve that reached the global map against the current extent and, with `drop`,
-// drops the implausible ones from the map.
+// Judges every curve that reached the global map against the current extent, and after a global
+// BA by how it fits its views (checkFit, when SanityOptions asks for it); with `drop`, drops the
+// implausible ones from the map.
 void Pipeline::Impl::checkCurves(bool drop) {
   extent = currentExtent();
-  if (!extent.valid()) return;
-  const ExportedCurves promoted = map.exportCurves(CurveSelection::kPromoted);
-  for (std::size_t i = 0; i < promoted.ids.size(); ++i) {
-    const CurveCheck check =
-        checkCurve(promoted.curves[i], extent, options.sanity.samples_per_segment);
-    if (check.reason == CurveImplausibility::kNone) continue;
-    implausible.push_back({promoted.ids[i], promoted.curves[i].numSegments(), check.length * unit(),
-                           check.reason, global_bas, drop});
-    if (drop) map.dropImplausible(promoted.ids[i]);
+  if (extent.valid()) {
+    const ExportedCurves promoted = map.exportCurves(CurveSelection::kPromoted);
+    for (std::size_t i = 0; i < promoted.ids.size(); ++i) {
+      const CurveCheck check =
+          checkCurve(promoted.curves[i], extent, options.sanity.samples_per_segment);
+      if (check.reason == CurveImplausibility::kNone) continue;
+      implausible.push_back({promoted.ids[i], promoted.curves[i].numSegments(),
+                             check.length * unit(), check.reason, global_bas, drop});
+      if (drop) map.dropImplausible(promoted.ids[i]);
+    }
   }
   const bool fit_checks =
       options.sanity.max_curve_residual_px > 0.0 || options.sanity.min_chord_ratio > 0.0;

@@ -211,9 +211,26 @@ int medianTrackKeyframes(const std::vector<CurveStatistics>& stats) {
   return keyframes.empty() ? 0 : static_cast<int>(upperMedian(keyframes));
 }
 
+// A curve whose chords shrank below this fraction of their lengths at creation counts as
+// collapsed in the summary: a point on an edge, which fits any view (docs/benchmarks.md).
+constexpr double kCollapsedChordRatio = 0.1;
+
+// Fraction of the curves whose chord ratio is below kCollapsedChordRatio; 0 without curves.
+double collapsedFraction(const std::vector<CurveStatistics>& stats) {
+  if (stats.empty()) return 0.0;
+  const auto collapsed = std::count_if(stats.begin(), stats.end(), [](const CurveStatistics& s) {
+    return s.chord_ratio < kCollapsedChordRatio;
+  });
+  return static_cast<double>(collapsed) / static_cast<double>(stats.size());
+}
+
 nlohmann::json curveStatisticsJson(const std::vector<CurveStatistics>& stats) {
+  std::vector<double> ratios;
+  for (const CurveStatistics& s : stats) ratios.push_back(s.chord_ratio);
   return {{"file", "curves.csv"},
           {"median_track_keyframes", medianTrackKeyframes(stats)},
+          {"median_chord_ratio", ratios.empty() ? 0.0 : upperMedian(ratios)},
+          {"collapsed_fraction", collapsedFraction(stats)},
           {"most_pull", worstCurvesJson(stats, CurveRanking::kPull)},
           {"highest_residual", worstCurvesJson(stats, CurveRanking::kResidual)}};
 }
@@ -233,10 +250,11 @@ void printCurveStatistics(const std::vector<CurveStatistics>& stats) {
   const double top_share = std::accumulate(shares.begin(), shares.begin() + top, 0.0);
   std::printf(
       "curves: track median %d keyframes; residual rms median %.2f px, 90th percentile %.2f px; "
-      "the %zu curves pulling the poses most hold %.0f %% of the pull (curves.csv, report.json "
-      "curve_statistics)\n",
+      "the %zu curves pulling the poses most hold %.0f %% of the pull; %.0f %% collapsed (chords "
+      "below %.1f of their lengths at creation) (curves.csv, report.json curve_statistics)\n",
       medianTrackKeyframes(stats), residuals[residuals.size() / 2],
-      residuals[residuals.size() * 9 / 10], top, 100.0 * top_share);
+      residuals[residuals.size() * 9 / 10], top, 100.0 * top_share,
+      100.0 * collapsedFraction(stats), kCollapsedChordRatio);
 }
 
 // ---------------------------------------------------------------------------------------------

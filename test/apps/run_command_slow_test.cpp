@@ -88,6 +88,11 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_THAT(result.output, HasSubstr("poses moved from the start (Sim(3) rmse, pose units): "));
   EXPECT_THAT(result.output, HasSubstr("curves: track median "));
   EXPECT_GE(report["curve_statistics"]["median_track_keyframes"].get<int>(), 2);
+  EXPECT_GT(report["curve_statistics"]["median_chord_ratio"].get<double>(), 0.0);
+  const double collapsed = report["curve_statistics"]["collapsed_fraction"].get<double>();
+  EXPECT_GE(collapsed, 0.0);
+  EXPECT_LE(collapsed, 1.0);
+  EXPECT_THAT(result.output, HasSubstr(" % collapsed (chords below 0.1 of their lengths"));
   EXPECT_EQ(report["curve_statistics"]["most_pull"].size(),
             std::min<std::size_t>(10, report["counts"]["curves"].get<std::size_t>()));
   std::ifstream csv(out + "/curves.csv");

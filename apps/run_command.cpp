@@ -476,7 +476,7 @@ const char* implausibilityText(CurveImplausibility reason) {
     case CurveImplausibility::kHighResidual:
       return "residual above the bound";
     case CurveImplausibility::kCollapsed:
-      return "collapsed";
+      return "chords below the bound";
     case CurveImplausibility::kNone:
       break;
   }
@@ -545,7 +545,7 @@ void printSanity(const RunSanity& s) {
   }
   std::printf(
       "; %zu of %d curves of the global map implausible (%d outside the extent, %d longer than "
-      "it, %d of high residual, %d collapsed), %d dropped",
+      "it, %d above the residual bound, %d below the chord-ratio bound), %d dropped",
       s.implausible_curves.size(), s.checked_curves,
       countImplausible(s, CurveImplausibility::kOutsideExtent),
       countImplausible(s, CurveImplausibility::kLongerThanExtent),

@@ -155,7 +155,8 @@ TEST_F(RunCommandTest, FitChecksDropCurvesThatDoNotFitTheirViews) {
   EXPECT_EQ(counts["dropped"], counts["checked"]);
   EXPECT_EQ(report["counts"]["curves"], 0);
   EXPECT_EQ(report["options"]["pipeline"]["sanity"]["max_curve_residual_px"], 0.001);
-  EXPECT_THAT(result.output, HasSubstr(" of high residual, "));
+  EXPECT_THAT(result.output,
+              HasSubstr(" above the residual bound, 0 below the chord-ratio bound)"));
   EXPECT_THAT(result.output, HasSubstr(", residual above the bound, dropped after 1 global BA"));
   EXPECT_THAT(result.output, HasSubstr("were implausible (outside the scene's extent"));
 }

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "apps/cli/cli_options.h"
@@ -13,6 +14,7 @@
 #include "apps/cli/report_json.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
+#include "core/median.h"
 
 namespace curvesfm {
 namespace {
@@ -72,10 +74,7 @@ double medianViewingDistance(const std::vector<MatchedPose>& matches,
       distances.push_back((points[i] - m.ground_truth.translation()).norm());
     }
   }
-  if (distances.empty()) return 0.0;
-  auto middle = distances.begin() + distances.size() / 2;
-  std::nth_element(distances.begin(), middle, distances.end());
-  return *middle;
+  return upperMedian(std::move(distances));
 }
 
 // Re-aligns `alignment` (a Sim(3) from the camera centres) from the camera frames instead

@@ -422,9 +422,8 @@ class StepEdgeRenderer {
         height_(height),
         half_contrast_(0.5 * contrast),
         fade_inside_(return_length > 0.0),
-        fade_length_(fade_inside_ ? return_length
-                                  : std::max(kReturnLengthPx, kReturnLengthSigmas * sigma)),
-        return_length_(fade_length_),
+        return_length_(fade_inside_ ? return_length
+                                    : std::max(kReturnLengthPx, kReturnLengthSigmas * sigma)),
         step_half_width_(kStepHalfWidthSigmas * sigma),
         band_(step_half_width_ + return_length_),
         offset_(static_cast<std::size_t>(width) * height, 0.0f),
@@ -541,7 +540,7 @@ class StepEdgeRenderer {
                       const Eigen::Vector2d& end_normal) {
     // A sliver of overlap between neighbouring strips, so that rounding cannot drop a pixel
     // centre lying on their common bisector.
-    const double beyond_ends = fade_inside_ ? 0.0 : 0.5 * fade_length_ + 1.0;
+    const double beyond_ends = fade_inside_ ? 0.0 : 0.5 * return_length_ + 1.0;
     const double before = piece.first ? beyond_ends : kStripOverlapPx;
     const double after = piece.last ? beyond_ends : kStripOverlapPx;
     const double reach = band_ + 1.0;
@@ -626,9 +625,9 @@ class StepEdgeRenderer {
   }
 
   double fade(double along, double total) const {
-    const double half = fade_inside_ ? 0.0 : 0.5 * fade_length_;
-    const double from_start = std::clamp((along + half) / fade_length_, 0.0, 1.0);
-    const double from_end = std::clamp((total - along + half) / fade_length_, 0.0, 1.0);
+    const double half = fade_inside_ ? 0.0 : 0.5 * return_length_;
+    const double from_start = std::clamp((along + half) / return_length_, 0.0, 1.0);
+    const double from_end = std::clamp((total - along + half) / return_length_, 0.0, 1.0);
     return from_start * from_end;
   }
 
@@ -636,8 +635,8 @@ class StepEdgeRenderer {
   int height_;
   double half_contrast_;
   bool fade_inside_;      // The fade ends at the polyline's ends rather than straddling them.
-  double fade_length_;    // Of the fade at each end (px).
-  double return_length_;  // Of the return to the background beside the curve (px).
+  // Of the return to the background beside the curve, and of the fade at each end (px).
+  double return_length_;
   double step_half_width_;
   double band_;
   std::vector<float> profile_;    // profile(r) at r = k * kProfileTableStepPx.

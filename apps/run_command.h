@@ -50,6 +50,10 @@ class RunCommand {
   std::string init_poses_path_;
   bool overlays_ = false;
   int export_samples_per_segment_ = 20;
+  /// curves.obj and curves.ply hold the curves whose median sample runs at least this far out of
+  /// their views' epipolar planes (deg; CurveStatistics::epipolar_angle_deg): the others' depth
+  /// along themselves is unobserved. 0 exports every curve.
+  double export_min_epipolar_angle_deg_ = 15.0;
   /// Seconds between the progress lines printed during a global BA (0: every iteration).
   double progress_interval_s_ = 5.0;
   /// Largest |t_image - t_pose| of an image matched to an initial pose (s).

@@ -111,6 +111,7 @@ struct BenchOptions {
   std::vector<std::string> variants = kVariantNames;  ///< Variants to run, in this order.
   std::string hybrid_flags = "--ba-points true";      ///< Extra flags of the hybrid variant.
   int max_frames = 0;  ///< Frame cap for every set (0: each set's own cap).
+  int stride = 0;      ///< Every stride-th image of every set (0: each set's own stride).
   int threads = 2;     ///< Threads for every solver flag curvesfm lists and for COLMAP.
   std::vector<std::string> starts = {"init"};      ///< Starts of the curves and hybrid variants.
   std::vector<int> noise_seeds = {1, 2, 3, 4, 5};  ///< One noise start per seed.
@@ -880,7 +881,7 @@ int run(const BenchOptions& options, const std::string& command) {
   for (const RealSet& set : sets) {
     ImageSequenceOptions sequence_options;
     sequence_options.camera = set.camera;
-    sequence_options.stride = set.stride;
+    sequence_options.stride = options.stride > 0 ? options.stride : set.stride;
     sequence_options.max_frames = set.max_frames;
     if (options.max_frames > 0 && (set.max_frames == 0 || options.max_frames < set.max_frames)) {
       sequence_options.max_frames = options.max_frames;
@@ -888,6 +889,11 @@ int run(const BenchOptions& options, const std::string& command) {
     const fs::path set_dir = out / set.name;
     fs::create_directories(set_dir);
     std::string set_note = set.why;
+    if (options.stride > 0 && options.stride != set.stride) {
+      set_note += std::string(set_note.empty() ? "" : "; ") + "every " +
+                  (options.stride == 1 ? std::string("") : std::to_string(options.stride) + "th ") +
+                  "frame (--stride)";
+    }
     if (sequence_options.max_frames > 0) {
       set_note += std::string(set_note.empty() ? "" : "; ") + "first " +
                   std::to_string(sequence_options.max_frames) + " frames";
@@ -1024,6 +1030,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-frames", options.max_frames,
                  "At most this many frames of every set (0: each set's own cap)")
       ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  app.add_option("--stride", options.stride,
+                 "Every stride-th frame of every set (0: each set's own; 7-Scenes takes every 3rd)")
+      ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   app.add_option_function<std::string>(
          "--starts",

@@ -65,11 +65,11 @@ void writePly(std::ostream& out, const Polylines& polylines) {
   }
 }
 
-void writeObj(std::ostream& out, const Polylines& polylines) {
+void writeObj(std::ostream& out, const Polylines& polylines, const std::vector<std::size_t>& ids) {
   out << "# curvesfm: densely sampled poly-Bezier curves, one polyline per curve\n";
   std::size_t next = 1;
   for (std::size_t k = 0; k < polylines.size(); ++k) {
-    out << "o curve_" << k << '\n';
+    out << "o curve_" << (ids.empty() ? k : ids[k]) << '\n';
     for (const Eigen::Vector3d& x : polylines[k]) writeVertex(out, "v ", x);
     out << 'l';
     for (std::size_t i = 0; i < polylines[k].size(); ++i) out << ' ' << next + i;
@@ -87,9 +87,11 @@ void writeCurvesPly(const std::string& path, const std::vector<PolyBezier>& curv
 }
 
 void writeCurvesObj(const std::string& path, const std::vector<PolyBezier>& curves,
-                    int samples_per_segment) {
+                    int samples_per_segment, const std::vector<std::size_t>& ids) {
+  CURVESFM_CHECK(ids.empty() || ids.size() == curves.size())
+      << ids.size() << " ids for " << curves.size() << " curves";
   const Polylines polylines = samplePolylines(curves, samples_per_segment);
-  writeExport(path, [&](std::ostream& out) { writeObj(out, polylines); });
+  writeExport(path, [&](std::ostream& out) { writeObj(out, polylines, ids); });
 }
 
 }  // namespace curvesfm

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -21,9 +22,11 @@ void writeCurvesPly(const std::string& path, const std::vector<PolyBezier>& curv
                     int samples_per_segment);
 
 /// Writes a Wavefront OBJ file: one `v x y z` line per vertex and, per curve, one `l i j ...` line
-/// through its vertices (1-based indices, as OBJ counts them), preceded by `o curve_<k>`.
+/// through its vertices (1-based indices, as OBJ counts them), preceded by `o curve_<k>`, k being
+/// the curve's index in `curves`, or ids[index] when `ids` is given (one per curve: a subset of
+/// a map keeps its curves' names).
 void writeCurvesObj(const std::string& path, const std::vector<PolyBezier>& curves,
-                    int samples_per_segment);
+                    int samples_per_segment, const std::vector<std::size_t>& ids = {});
 
 }  // namespace curvesfm
 

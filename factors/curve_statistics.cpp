@@ -51,6 +51,44 @@ void viewingGeometry(const std::vector<Eigen::Vector3d>& centres, const Eigen::V
   s->triangulation_angle_deg = widest * kRadToDeg;
 }
 
+// At most this many observing centres, spread evenly over the track, enter the epipolar angle
+// (their pairs are tried per sample).
+constexpr int kEpipolarCentres = 6;
+
+// The widest angle (rad) over pairs of `centres` between `tangent` (unit) and the plane through
+// `point` and the pair; 0 when no pair spans a plane with the point.
+double widestEpipolarAngle(const std::vector<Eigen::Vector3d>& centres,
+                           const Eigen::Vector3d& point, const Eigen::Vector3d& tangent) {
+  double widest = 0.0;
+  for (std::size_t a = 0; a < centres.size(); ++a) {
+    for (std::size_t b = a + 1; b < centres.size(); ++b) {
+      const Eigen::Vector3d normal = (centres[b] - centres[a]).cross(point - centres[a]);
+      const double norm = normal.norm();
+      if (norm <= 0.0) continue;
+      widest = std::max(widest, std::asin(std::min(1.0, std::abs(normal.dot(tangent)) / norm)));
+    }
+  }
+  return widest;
+}
+
+// CurveStatistics::epipolar_angle_deg of `curve` seen from `centres` (in track order).
+double epipolarAngleDeg(const PolyBezier& curve, const std::vector<Eigen::Vector3d>& centres) {
+  if (centres.size() < 2) return 90.0;
+  std::vector<Eigen::Vector3d> spread;
+  const std::size_t n = std::min<std::size_t>(centres.size(), kEpipolarCentres);
+  for (std::size_t k = 0; k < n; ++k) spread.push_back(centres[k * (centres.size() - 1) / (n - 1)]);
+  std::vector<double> angles;
+  for (int i = 0; i < curve.numSegments(); ++i) {
+    for (int k = 0; k < kLengthSamplesPerSegment; ++k) {
+      const double t = (k + 0.5) / kLengthSamplesPerSegment;
+      const Eigen::Vector3d tangent = curve.derivative(i, t);
+      if (tangent.norm() <= 0.0) continue;
+      angles.push_back(widestEpipolarAngle(spread, curve.evaluate(i, t), tangent.normalized()));
+    }
+  }
+  return angles.empty() ? 90.0 : upperMedian(angles) * kRadToDeg;
+}
+
 // Sum of squared residuals over some samples.
 struct SquaredResiduals {
   double squared = 0.0;
@@ -111,6 +149,7 @@ std::vector<CurveStatistics> curveStatistics(const CurveBundleAdjustmentInput& i
     std::vector<Eigen::Vector3d> centres;
     for (int j : keyframes_of[c]) centres.push_back(input.cam_from_world[j].inverseTranslation());
     viewingGeometry(centres, middleOf(input.curves[c]), &s);
+    s.epipolar_angle_deg = epipolarAngleDeg(input.curves[c], centres);
   }
   if (input.observations.empty()) return stats;
 

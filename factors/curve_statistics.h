@@ -36,6 +36,13 @@ struct CurveStatistics {
   double chord_ratio = 1.0;
   double median_camera_distance = 0.0;   ///< Observing camera centres to its middle (length unit).
   double triangulation_angle_deg = 0.0;  ///< Widest angle between observing rays at its middle.
+  /// How far the curve runs out of the epipolar planes of its views (deg): per sample, the widest
+  /// angle over pairs of observing centres between its tangent and the plane through the sample
+  /// and the pair; the median over its samples. Near 0 the curve runs along every epipolar line
+  /// it is seen on, so its depth along itself is not observed: the edge residuals hold it
+  /// equally well tilted in depth (a sideways walk past a horizontal edge, an orbit past a
+  /// horizontal ledge). 90 when fewer than two distinct centres observe it.
+  double epipolar_angle_deg = 90.0;
   double pose_pull = 0.0;                ///< See above.
   double pose_pull_share = 0.0;  ///< pose_pull over the sum of all curves' (0 when none pull).
 };

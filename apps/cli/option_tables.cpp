@@ -371,6 +371,10 @@ void addSanityOptions(OptionsTable* table, SanityOptions* o, const OptionPlace& 
       .number("min_chord_ratio", "min-chord-ratio", &o->min_chord_ratio,
               "After each global BA, a curve whose chords shrank below this fraction of their "
               "lengths at creation is implausible too (0: off)")
+      .number("min_epipolar_angle_deg", "min-epipolar-angle", &o->min_epipolar_angle_deg,
+              "After each global BA, a curve whose median sample runs within this angle of its "
+              "views' epipolar planes is implausible too: its depth along itself is unobserved "
+              "(deg; 0: off)")
       .number("max_implausible_fraction", "max-implausible-fraction", &o->max_implausible_fraction,
               "Verdict when more than this fraction of the global map's curves is implausible")
       .number("max_pose_move_spacings", "max-pose-move", &o->max_pose_move_spacings,

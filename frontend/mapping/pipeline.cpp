@@ -866,9 +866,13 @@ void Pipeline::Impl::checkCurves(bool drop) {
       if (drop) map.dropImplausible(promoted.ids[i]);
     }
   }
+  // A curve's fit means something only once a global BA has fitted it; its run along the
+  // epipolar planes is geometry, judged from the frontend's map on.
   const bool fit_checks =
       options.sanity.max_curve_residual_px > 0.0 || options.sanity.min_chord_ratio > 0.0;
-  if (fit_checks && global_bas > 0) checkFit(drop);
+  if ((fit_checks && global_bas > 0) || options.sanity.min_epipolar_angle_deg > 0.0) {
+    checkFit(drop);
+  }
 }
 
 // Judges every curve still in the map by how it fits its views after a global BA: its residual
@@ -880,11 +884,13 @@ void Pipeline::Impl::checkFit(bool drop) {
   const std::vector<CurveStatistics> stats = curveStatistics(input, options.ba);
   for (std::size_t i = 0; i < ids.size(); ++i) {
     CurveImplausibility reason = CurveImplausibility::kNone;
-    if (sanity.max_curve_residual_px > 0.0 &&
+    if (global_bas > 0 && sanity.max_curve_residual_px > 0.0 &&
         stats[i].residual_rms_px > sanity.max_curve_residual_px) {
       reason = CurveImplausibility::kHighResidual;
-    } else if (stats[i].chord_ratio < sanity.min_chord_ratio) {
+    } else if (global_bas > 0 && stats[i].chord_ratio < sanity.min_chord_ratio) {
       reason = CurveImplausibility::kCollapsed;
+    } else if (stats[i].epipolar_angle_deg < sanity.min_epipolar_angle_deg) {
+      reason = CurveImplausibility::kAlongEpipolar;
     }
     if (reason == CurveImplausibility::kNone) continue;
     const CurveCheck check = checkCurve(input.curves[i], extent, sanity.samples_per_segment);

@@ -22,6 +22,8 @@ void SanityOptions::validate() const {
           "max_curve_residual_px", max_curve_residual_px, "finite and >= 0");
   require(min_chord_ratio >= 0.0 && min_chord_ratio < 1.0, "min_chord_ratio", min_chord_ratio,
           "in [0, 1)");
+  require(min_epipolar_angle_deg >= 0.0 && min_epipolar_angle_deg < 90.0, "min_epipolar_angle_deg",
+          min_epipolar_angle_deg, "in [0, 90)");
   require(max_implausible_fraction >= 0.0 && max_implausible_fraction <= 1.0,
           "max_implausible_fraction", max_implausible_fraction, "in [0, 1]");
   require.positive("max_pose_move_spacings", max_pose_move_spacings);

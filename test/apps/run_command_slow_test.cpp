@@ -95,10 +95,22 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_THAT(result.output, HasSubstr(" % collapsed (chords below 0.1 of their lengths"));
   EXPECT_EQ(report["curve_statistics"]["most_pull"].size(),
             std::min<std::size_t>(10, report["counts"]["curves"].get<std::size_t>()));
+  // curves.csv lists every curve of the map, its last column saying whether curves.obj holds it.
   std::ifstream csv(out + "/curves.csv");
   int csv_lines = 0;
-  for (std::string line; std::getline(csv, line);) ++csv_lines;
+  int exported = 0;
+  for (std::string line; std::getline(csv, line);) {
+    if (csv_lines++ == 0) continue;
+    exported += line.back() == '1' ? 1 : 0;
+  }
   EXPECT_EQ(csv_lines, 1 + report["counts"]["curves"].get<int>());
+  EXPECT_EQ(exported, report["counts"]["curves_exported"].get<int>());
+  EXPECT_GT(exported, 0);
+  std::ifstream obj(out + "/curves.obj");
+  int objects = 0;
+  for (std::string line; std::getline(obj, line);) objects += line.rfind("o curve_", 0) == 0;
+  EXPECT_EQ(objects, exported);
+  EXPECT_THAT(result.output, HasSubstr(" curves in curves.obj and curves.ply; "));
   // The sanity checks: the extent, the counts, and each verdict printed as a warning line.
   EXPECT_THAT(result.output, HasSubstr("sanity: scene extent "));
   const nlohmann::json& sanity = report["sanity"];
@@ -155,8 +167,8 @@ TEST_F(RunCommandTest, FitChecksDropCurvesThatDoNotFitTheirViews) {
   EXPECT_EQ(counts["dropped"], counts["checked"]);
   EXPECT_EQ(report["counts"]["curves"], 0);
   EXPECT_EQ(report["options"]["pipeline"]["sanity"]["max_curve_residual_px"], 0.001);
-  EXPECT_THAT(result.output,
-              HasSubstr(" above the residual bound, 0 below the chord-ratio bound)"));
+  EXPECT_THAT(result.output, HasSubstr(" above the residual bound, 0 below the chord-ratio bound, "
+                                       "0 along their epipolar planes)"));
   EXPECT_THAT(result.output, HasSubstr(", residual above the bound, dropped after 1 global BA"));
   EXPECT_THAT(result.output, HasSubstr("were implausible (outside the scene's extent"));
 }

@@ -96,6 +96,13 @@ TEST_F(CurveExportTest, ObjHasVertexLinesAndOnePolylinePerCurveWithOneBasedIndic
   EXPECT_THAT(linesStartingWith(lines, "o "), ::testing::ElementsAre("o curve_0", "o curve_1"));
 }
 
+TEST_F(CurveExportTest, ObjNamesASubsetsCurvesByTheirIds) {
+  writeCurvesObj(path("c.obj"), {unitLine(), twoSegmentLine()}, 2, {3, 7});
+  EXPECT_THAT(linesStartingWith(readLines(path("c.obj")), "o "),
+              ::testing::ElementsAre("o curve_3", "o curve_7"));
+  EXPECT_THROW(writeCurvesObj(path("c.obj"), {unitLine()}, 2, {1, 2}), CheckError);
+}
+
 TEST_F(CurveExportTest, NoCurvesGiveValidEmptyFiles) {
   writeCurvesPly(path("e.ply"), {}, 10);
   writeCurvesObj(path("e.obj"), {}, 10);

@@ -94,5 +94,40 @@ TEST(CurveStatistics, FindsTheKeyframeWhereEachCurveIsWorst) {
   EXPECT_GT(checked, 0);
 }
 
+// A straight curve of `segments` equal segments from `from` along `direction` (unit), `length`
+// long.
+PolyBezier straightCurve(const Eigen::Vector3d& from, const Eigen::Vector3d& direction,
+                         double length, int segments) {
+  const double step = length / segments;
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i <= segments; ++i) points.push_back(from + i * step * direction);
+  return PolyBezier(points, std::vector<Direction>(points.size(), Direction(direction)),
+                    std::vector<SegmentLengths>(segments, {step / 3.0, step / 3.0}));
+}
+
+TEST(CurveStatistics, MeasuresHowFarACurveRunsOutOfItsEpipolarPlanes) {
+  const CurveScene scene = smallScene();
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene, SceneStart::kTruth);
+  // The orbit's centres lie in one plane: every epipolar plane through a point of that plane is
+  // the plane itself, so a line in it runs along every epipolar line it is seen on (0 deg). A
+  // line rising across it from the same point is 90 deg out at its foot and a little less above
+  // it, where the epipolar planes tilt towards it.
+  std::vector<Eigen::Vector3d> centres;
+  for (const Pose3& pose : input.cam_from_world) centres.push_back(pose.inverseTranslation());
+  ASSERT_GE(centres.size(), 3u);
+  const Eigen::Vector3d normal =
+      (centres[1] - centres[0]).cross(centres[2] - centres[0]).normalized();
+  const Eigen::Vector3d middle = input.curves[0].evaluate(0, 0.5);
+  const Eigen::Vector3d in_plane = middle - normal.dot(middle - centres[0]) * normal;
+  const Eigen::Vector3d along = normal.cross(in_plane - centres[0]).normalized();
+  input.curves[0] = straightCurve(in_plane, along, 0.3, input.curves[0].numSegments());
+  input.curves[1] = straightCurve(in_plane, normal, 0.3, input.curves[1].numSegments());
+  const std::vector<CurveStatistics> stats = curveStatistics(input, {});
+  ASSERT_GE(stats[0].keyframes, 2);
+  ASSERT_GE(stats[1].keyframes, 2);
+  EXPECT_LT(stats[0].epipolar_angle_deg, 1.0);
+  EXPECT_GT(stats[1].epipolar_angle_deg, 80.0);
+}
+
 }  // namespace
 }  // namespace curvesfm

@@ -183,6 +183,11 @@ TEST(SanityOptions, ValidateNamesTheField) {
   EXPECT_THAT(
       [&] { options.validate(); },
       testing::ThrowsMessage<InvalidOptions>(testing::HasSubstr("SanityOptions.min_chord_ratio")));
+  options = {};
+  options.min_epipolar_angle_deg = 90.0;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<InvalidOptions>(
+                  testing::HasSubstr("SanityOptions.min_epipolar_angle_deg")));
 }
 
 }  // namespace

@@ -890,9 +890,9 @@ int run(const BenchOptions& options, const std::string& command) {
     fs::create_directories(set_dir);
     std::string set_note = set.why;
     if (options.stride > 0 && options.stride != set.stride) {
-      set_note += std::string(set_note.empty() ? "" : "; ") + "every " +
-                  (options.stride == 1 ? std::string("") : std::to_string(options.stride) + "th ") +
-                  "frame (--stride)";
+      set_note += std::string(set_note.empty() ? "" : "; ") + "--stride " +
+                  std::to_string(options.stride) + " overrides the table's stride " +
+                  std::to_string(set.stride);
     }
     if (sequence_options.max_frames > 0) {
       set_note += std::string(set_note.empty() ? "" : "; ") + "first " +

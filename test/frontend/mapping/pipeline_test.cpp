@@ -31,7 +31,7 @@ TEST(PipelineOptions, LocalBaKeyframesPerCurveMustExceedTheWindow) {
                   "local_ba.local_window (5)")));
   options.local_ba_max_curve_keyframes = 6;
   EXPECT_NO_THROW(options.validate());
-  EXPECT_EQ(PipelineOptions{}.local_ba_max_curve_keyframes, 0);
+  EXPECT_EQ(PipelineOptions{}.local_ba_max_curve_keyframes, 20);
 }
 
 TEST(PipelineOptions, ValidateChecksTheReassociationGates) {

@@ -372,9 +372,9 @@ void addSanityOptions(OptionsTable* table, SanityOptions* o, const OptionPlace& 
               "After each global BA, a curve whose chords shrank below this fraction of their "
               "lengths at creation is implausible too (0: off)")
       .number("min_epipolar_angle_deg", "min-epipolar-angle", &o->min_epipolar_angle_deg,
-              "After each global BA, a curve whose median sample runs within this angle of its "
-              "views' epipolar planes is implausible too: its depth along itself is unobserved "
-              "(deg; 0: off)")
+              "Before the first global BA and after each, a curve whose median sample runs within "
+              "this angle of its views' epipolar planes is implausible too: its depth along "
+              "itself is unobserved (deg; 0: off)")
       .number("max_implausible_fraction", "max-implausible-fraction", &o->max_implausible_fraction,
               "Verdict when more than this fraction of the global map's curves is implausible")
       .number("max_pose_move_spacings", "max-pose-move", &o->max_pose_move_spacings,

@@ -45,10 +45,12 @@ struct SanityOptions {
   /// After each global BA, a curve whose chords sum to less than this fraction of their lengths
   /// at creation (CurveStatistics::chord_ratio) is implausible too. In [0, 1); 0 off.
   double min_chord_ratio = 0.0;
-  /// After each global BA, a curve whose median sample runs within this angle of the epipolar
-  /// planes of its views (CurveStatistics::epipolar_angle_deg) is implausible too (deg): its
-  /// depth along itself is unobserved, so the BA keeps it wherever it was lifted, often tilted in
-  /// depth, and it holds the poses to that. In [0, 90); 0 off.
+  /// Before the first global BA and after each, a curve whose median sample runs within this
+  /// angle of the epipolar planes of its views (CurveStatistics::epipolar_angle_deg) is
+  /// implausible too (deg): its depth along itself is unobserved, so the BA keeps it wherever it
+  /// was lifted, often tilted in depth. Off by default: such curves still hold the poses across
+  /// their edges, and dropping them made Pavilion's trajectories worse (docs/benchmarks.md,
+  /// "Curves along their epipolar planes"). In [0, 90); 0 off.
   double min_epipolar_angle_deg = 0.0;
   /// Verdict when more than this fraction of the curves that reached the global map were
   /// implausible (unitless). In [0, 1].
@@ -104,8 +106,8 @@ enum class CurveImplausibility {
   /// Its chords sum to less than SanityOptions::min_chord_ratio of their lengths at creation
   /// after a global BA: it has collapsed towards a point of an edge, which fits any view.
   kCollapsed,
-  /// It runs within SanityOptions::min_epipolar_angle_deg of its views' epipolar planes after a
-  /// global BA: its depth along itself is unobserved.
+  /// It runs within SanityOptions::min_epipolar_angle_deg of its views' epipolar planes: its
+  /// depth along itself is unobserved.
   kAlongEpipolar,
 };
 

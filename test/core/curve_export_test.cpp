@@ -96,7 +96,7 @@ TEST_F(CurveExportTest, ObjHasVertexLinesAndOnePolylinePerCurveWithOneBasedIndic
   EXPECT_THAT(linesStartingWith(lines, "o "), ::testing::ElementsAre("o curve_0", "o curve_1"));
 }
 
-TEST_F(CurveExportTest, ObjNamesASubsetsCurvesByTheirIds) {
+TEST_F(CurveExportTest, ObjNamesTheCurvesOfASubsetByTheirIds) {
   writeCurvesObj(path("c.obj"), {unitLine(), twoSegmentLine()}, 2, {3, 7});
   EXPECT_THAT(linesStartingWith(readLines(path("c.obj")), "o "),
               ::testing::ElementsAre("o curve_3", "o curve_7"));

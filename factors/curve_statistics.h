@@ -41,7 +41,8 @@ struct CurveStatistics {
   /// and the pair; the median over its samples. Near 0 the curve runs along every epipolar line
   /// it is seen on, so its depth along itself is not observed: the edge residuals hold it
   /// equally well tilted in depth (a sideways walk past a horizontal edge, an orbit past a
-  /// horizontal ledge). 90 when fewer than two distinct centres observe it.
+  /// horizontal ledge), and 0 when its observing centres all coincide (no baseline). 90 when
+  /// fewer than two keyframes observe it: nothing to judge.
   double epipolar_angle_deg = 90.0;
   double pose_pull = 0.0;                ///< See above.
   double pose_pull_share = 0.0;  ///< pose_pull over the sum of all curves' (0 when none pull).

@@ -144,6 +144,13 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   result = run("--progress-interval -1");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("progress-interval = -1: finite and >= 0"));
+  result = run("--export-min-epipolar-angle 90");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("export-min-epipolar-angle = 90: in [0, 90)"));
+  result = run("--sanity-min-epipolar-angle -1");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--sanity-min-epipolar-angle = -1: in [0, 90) "
+                                       "(SanityOptions.min_epipolar_angle_deg)"));
   result = run("--sanity-extent-margin -1");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--sanity-extent-margin = -1: must be >= 0 and finite "

@@ -19,7 +19,9 @@
 // report.json) and refined / start; the summary prints them per set and start, with the spread
 // over the noise seeds, beside issue 14's targets. --map-at truth|noise<seed> (truth and noise
 // starts only) makes every such run lift and register its curves at that start's poses
-// (`run --diagnose-frontend-poses`), so a map and a start of different errors meet. A set with
+// (`run --diagnose-frontend-poses`), so a map and a start of different errors meet;
+// --noise-start-prior true gives every noise start's run `--ba-start-prior` at the noise's own
+// sigmas (a start known per pose to within them). A set with
 // ground-truth curves (Pavilion) also gets `curvesfm eval-map` on every curve run: precision and
 // recall of the curve map at 2 cm. curvesfm runs as a subprocess (--curvesfm, default the one built
 // beside this bench); a variant whose flags the executable does not list in its --help is skipped
@@ -118,6 +120,9 @@ struct BenchOptions {
   /// Shift per axis of a noise start, as a fraction of the median camera spacing (unitless).
   double noise_spacing_fraction = 0.01;
   double noise_rotation_deg = 0.1;  ///< Rotation per axis of a noise start (deg).
+  /// Tell each noise start's run how its poses were perturbed: `run --ba-start-prior` at the
+  /// noise's own sigmas (a start known per pose to within them).
+  bool noise_start_prior = false;
   /// Diagnosis: the start ("truth" or "noiseN") whose poses lift and register every curve of
   /// the truth and noise runs (`run --diagnose-frontend-poses`), so that a map and a start of
   /// different errors meet; empty: each run lifts its map at its own start.
@@ -805,6 +810,24 @@ Variant withMapAt(Variant variant, const ImageSequence& sequence, const BenchOpt
   return variant;
 }
 
+/// With --noise-start-prior, a noise start's run holds each pose to its start at the noise's
+/// sigmas (the rotation per axis, and the shift as a fraction of the camera spacing).
+Variant withStartPrior(Variant variant, const Start& start, const BenchOptions& options) {
+  const auto text = [](double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof(buffer), "%.10g", value);
+    return std::string(buffer);
+  };
+  if (!options.noise_start_prior || start.kind != "noise" || variant.command != "run") {
+    return variant;
+  }
+  variant.flags.insert(
+      variant.flags.end(),
+      {"--ba-start-prior", "true", "--ba-start-prior-rotation", text(options.noise_rotation_deg),
+       "--ba-start-prior-centre", text(options.noise_spacing_fraction)});
+  return variant;
+}
+
 bool wantsColmapStart(const BenchOptions& options) {
   return std::find(options.starts.begin(), options.starts.end(), "colmap") != options.starts.end();
 }
@@ -935,7 +958,8 @@ int run(const BenchOptions& options, const std::string& command) {
           } else {
             const std::string init_poses =
                 startPosesFile(start, sequence, colmap_poses, options, set_dir);
-            run_variant = withMapAt(variant, sequence, options, set_dir);
+            run_variant =
+                withStartPrior(withMapAt(variant, sequence, options, set_dir), start, options);
             runCurvesfm(options, run_variant, set, sequence, sequence_options, init_poses,
                         &catalogue, dir, &row);
           }
@@ -1071,6 +1095,10 @@ int main(int argc, char** argv) {
   app.add_option("--noise-rotation-deg", options.noise_rotation_deg,
                  "Noise start: rotation per axis (deg)")
       ->check(CLI::Range(0.0, 90.0))
+      ->capture_default_str();
+  app.add_option("--noise-start-prior", options.noise_start_prior,
+                 "Noise starts: run with --ba-start-prior at the noise's own sigmas (each pose "
+                 "known to within them)")
       ->capture_default_str();
   app.add_option_function<std::string>(
          "--map-at",

@@ -7,6 +7,7 @@
 #include "core/check.h"
 #include "core/errors.h"
 #include "factors/point_reprojection_factor.h"
+#include "factors/pose_prior_factor.h"
 #include "factors/relative_pose_factor.h"
 #include "factors/segment_length_factor.h"
 #include "factors/tangent_alignment_factor.h"
@@ -97,6 +98,17 @@ void addMotionPrior(const std::vector<Pose3>& prior_cam_from_world,
   }
 }
 
+void addStartPrior(const std::vector<Pose3>& prior_cam_from_world,
+                   const CurveBundleAdjustmentOptions& options, FactorGraph* graph) {
+  const double rotation_sigma = options.start_prior_rotation_sigma_deg * M_PI / 180.0;
+  const double centre_sigma =
+      options.start_prior_centre_sigma_rel * std::max(meanCameraStep(prior_cam_from_world), 1e-12);
+  for (std::size_t j = 0; j < prior_cam_from_world.size(); ++j) {
+    graph->emplace<CameraPriorFactor>(poseKey(static_cast<int>(j)), prior_cam_from_world[j],
+                                      rotation_sigma, centre_sigma);
+  }
+}
+
 }  // namespace
 
 void CurveBundleAdjustmentOptions::validate() const {
@@ -119,6 +131,8 @@ void CurveBundleAdjustmentOptions::validate() const {
   require.positive("scale_sigma", scale_sigma);
   require.positive("motion_prior_rotation_sigma_deg", motion_prior_rotation_sigma_deg);
   require.positive("motion_prior_translation_sigma_rel", motion_prior_translation_sigma_rel);
+  require.positive("start_prior_rotation_sigma_deg", start_prior_rotation_sigma_deg);
+  require.positive("start_prior_centre_sigma_rel", start_prior_centre_sigma_rel);
   require.positive("point_pixel_sigma", point_pixel_sigma);
   require.positive("point_kernel_width", point_kernel_width);
 }
@@ -180,6 +194,12 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
         << "curve bundle adjustment: " << input.motion_prior_cam_from_world.size()
         << " motion-prior poses for " << num_keyframes << " keyframes";
     addMotionPrior(input.motion_prior_cam_from_world, options, &problem.graph);
+  }
+  if (options.start_prior && !input.motion_prior_cam_from_world.empty()) {
+    CURVESFM_CHECK(input.motion_prior_cam_from_world.size() == input.cam_from_world.size())
+        << "curve bundle adjustment: " << input.motion_prior_cam_from_world.size()
+        << " start-prior poses for " << num_keyframes << " keyframes";
+    addStartPrior(input.motion_prior_cam_from_world, options, &problem.graph);
   }
   return problem;
 }

@@ -87,6 +87,16 @@ struct CurveBundleAdjustmentOptions {
   /// docs/benchmarks.md).
   double motion_prior_rotation_sigma_deg = 0.02;
   double motion_prior_translation_sigma_rel = 0.03;
+  /// Tie each keyframe's orientation and centre to its pose in
+  /// CurveBundleAdjustmentInput::motion_prior_cam_from_world (a CameraPriorFactor per keyframe):
+  /// for a start whose poses are each known to within a rotation and a shift, independent per
+  /// pose (a noisy start, GNSS/INS). Off by default: a start that drifts (odometry, the point
+  /// initialiser) is off by more than its local accuracy, and this prior would hold that drift.
+  bool start_prior = false;
+  /// Std dev per axis of that orientation (deg), and of that centre as a fraction of the prior
+  /// trajectory's mean distance between consecutive camera centres; > 0.
+  double start_prior_rotation_sigma_deg = 0.1;
+  double start_prior_centre_sigma_rel = 0.01;
   /// The hybrid graph (issue 13): the point initialiser's points stay in the graph, one
   /// PointReprojectionFactor per observation in a keyframe beside the curve factors, with their
   /// own noise and kernel. Only when the input has points.

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/check.h"
+#include "core/so3.h"
 
 namespace curvesfm {
 
@@ -15,6 +16,37 @@ PosePriorFactor::Error PosePriorFactor::evaluateError(const Pose3& pose,
   Matrix6d H;
   const Vector6d error = prior_.localCoordinates(pose, nullptr, &H);
   *H_pose = H;
+  return error;
+}
+
+CameraPriorFactor::CameraPriorFactor(Key pose_key, const Pose3& prior_cam_from_world,
+                                     double rotation_sigma, double centre_sigma,
+                                     NoiseModel noise_model)
+    : Base({pose_key}, std::move(noise_model)),
+      prior_rotation_(prior_cam_from_world.rotation()),
+      prior_centre_(prior_cam_from_world.inverseTranslation()) {
+  CURVESFM_CHECK(std::isfinite(rotation_sigma) && rotation_sigma > 0.0 &&
+                 std::isfinite(centre_sigma) && centre_sigma > 0.0)
+      << "CameraPriorFactor sigmas must be > 0, got rotation " << rotation_sigma << ", centre "
+      << centre_sigma;
+  rotation_weight_ = 1.0 / rotation_sigma;
+  centre_weight_ = 1.0 / centre_sigma;
+}
+
+CameraPriorFactor::Error CameraPriorFactor::evaluateError(const Pose3& cam_from_world,
+                                                          Jacobian<Pose3>* H_pose) const {
+  Matrix36d d_centre;
+  const Eigen::Vector3d centre = cam_from_world.inverseTranslation(H_pose ? &d_centre : nullptr);
+  const Eigen::Vector3d rotation_error =
+      so3::log(cam_from_world.rotation() * prior_rotation_.conjugate());
+  Error error;
+  error << rotation_weight_ * rotation_error, centre_weight_ * (centre - prior_centre_);
+  if (H_pose) {
+    // The tangent turns R on the left: log(exp(w) R R_prior^T) ~= e + JlInv(e) w.
+    H_pose->setZero();
+    H_pose->topLeftCorner<3, 3>() = rotation_weight_ * so3::leftJacobianInverse(rotation_error);
+    H_pose->bottomRows<3>() = centre_weight_ * d_centre;
+  }
   return error;
 }
 

@@ -23,6 +23,30 @@ class PosePriorFactor : public NoiseModelFactorN<6, Pose3> {
   Pose3 prior_;
 };
 
+/// A prior on a camera's orientation and centre in world, each with its own std dev, e.g. a start
+/// whose poses are known to within a rotation and a shift per axis:
+///   e = [log(R R_prior^T) / rotation_sigma; (c - c_prior) / centre_sigma],  c = -R^T t,
+/// already whitened (dimensionless; give it a NoiseModel of sigma 1). Unlike PosePriorFactor it
+/// holds the centre, not t = -R c, so a turn of the camera does not move its prior position.
+/// Key: one Pose3 (cam_from_world). Jacobian 6x6 w.r.t. the pose tangent.
+class CameraPriorFactor : public NoiseModelFactorN<6, Pose3> {
+  using Base = NoiseModelFactorN<6, Pose3>;
+
+ public:
+  /// Throws CheckError unless both sigmas are > 0 and finite.
+  CameraPriorFactor(Key pose_key, const Pose3& prior_cam_from_world, double rotation_sigma,
+                    double centre_sigma, NoiseModel noise_model = {});
+
+  Error evaluateError(const Pose3& cam_from_world, Jacobian<Pose3>* H_pose) const override;
+  const char* typeName() const override { return "camera_prior"; }
+
+ private:
+  Eigen::Quaterniond prior_rotation_;
+  Eigen::Vector3d prior_centre_;
+  double rotation_weight_;
+  double centre_weight_;
+};
+
 /// Fixes the monocular scale gauge: the distance between two camera centres,
 ///   e = |c_j - c_i| - distance,   c = -R^T t for each cam_from_world pose.
 /// Keys: two Pose3 (cam_from_world). Jacobians 1x6 each. When the centres coincide the

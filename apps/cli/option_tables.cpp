@@ -329,6 +329,16 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
               &b->motion_prior_translation_sigma_rel,
               "Std dev per axis of that motion's translation, as a fraction of the mean distance "
               "between consecutive keyframes")
+      .boolean("start_prior", "start-prior", &b->start_prior,
+               "Tie each keyframe's orientation and centre to its initial pose (a start known "
+               "per pose to within the two sigmas below)")
+      .number("start_prior_rotation_sigma_deg", "start-prior-rotation",
+              &b->start_prior_rotation_sigma_deg,
+              "Std dev per axis of each keyframe's initial orientation (deg)")
+      .number("start_prior_centre_sigma_rel", "start-prior-centre",
+              &b->start_prior_centre_sigma_rel,
+              "Std dev per axis of each keyframe's initial centre, as a fraction of the mean "
+              "distance between consecutive keyframes")
       .boolean("points", "points", &b->points,
                "Hybrid graph: keep the initialiser's points beside the curves")
       .number("point_pixel_sigma", "point-sigma", &b->point_pixel_sigma,

@@ -145,23 +145,46 @@ TEST(CurveBundleAdjustment, PartlyHiddenCurvesAreNotBiasedWithTheOrientationChec
   EXPECT_LT(checked.after.curve_mean_error_aligned, 0.3 * unchecked.after.curve_mean_error_aligned);
 }
 
-TEST(CurveBundleAdjustment, ATightMotionPriorKeepsThePriorsRelativeMotions) {
-  const CurveScene scene = makeCurveScene(perturbedScene());
+// The perturbed scene's poses after a joint solve with the truth as the priors' trajectory.
+std::vector<Pose3> posesWithPriorsAtTheTruth(const CurveScene& scene,
+                                             const CurveBundleAdjustmentOptions& ba) {
   CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
   input.motion_prior_cam_from_world = scene.true_cam_from_world;
-  CurveBundleAdjustmentOptions ba;
-  ba.motion_prior_rotation_sigma_deg = 1e-4;
-  ba.motion_prior_translation_sigma_rel = 1e-6;
   CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
   SchedulerOptions scheduler;
   scheduler.optimizer.max_iterations = 100;
   runSchedule(problem.graph, &problem.values, problem.config, scheduler);
-  const std::vector<Pose3> poses = extractPoses(problem.values, input.cam_from_world.size());
+  return extractPoses(problem.values, input.cam_from_world.size());
+}
+
+TEST(CurveBundleAdjustment, ATightMotionPriorKeepsThePriorsRelativeMotions) {
+  const CurveScene scene = makeCurveScene(perturbedScene());
+  CurveBundleAdjustmentOptions ba;
+  ba.motion_prior_rotation_sigma_deg = 1e-4;
+  ba.motion_prior_translation_sigma_rel = 1e-6;
+  const std::vector<Pose3> poses = posesWithPriorsAtTheTruth(scene, ba);
   for (std::size_t j = 1; j < poses.size(); ++j) {
     const Pose3 motion = poses[j] * poses[j - 1].inverse();
     const Pose3 truth = scene.true_cam_from_world[j] * scene.true_cam_from_world[j - 1].inverse();
     // The start is ~2 cm / 1 deg off per pose; the prior pins each motion to ~1e-6.
     EXPECT_LT(truth.localCoordinates(motion).norm(), 1e-4) << "keyframes " << j - 1 << ", " << j;
+  }
+}
+
+TEST(CurveBundleAdjustment, ATightStartPriorKeepsEveryCentreAndOrientation) {
+  const CurveScene scene = makeCurveScene(perturbedScene());
+  CurveBundleAdjustmentOptions ba;
+  ba.motion_prior = false;
+  ba.fix_first_pose = false;
+  ba.start_prior = true;
+  ba.start_prior_rotation_sigma_deg = 1e-4;
+  ba.start_prior_centre_sigma_rel = 1e-6;
+  const std::vector<Pose3> poses = posesWithPriorsAtTheTruth(scene, ba);
+  for (std::size_t j = 0; j < poses.size(); ++j) {
+    // The start is ~2 cm / 1 deg off per pose; the prior pins each pose to its truth.
+    const Pose3& truth = scene.true_cam_from_world[j];
+    EXPECT_LT(cameraCentreDistance(poses[j], truth), 1e-4) << "keyframe " << j;
+    EXPECT_LT(poses[j].rotation().angularDistance(truth.rotation()), 1e-5) << "keyframe " << j;
   }
 }
 

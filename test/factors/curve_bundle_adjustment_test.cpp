@@ -34,6 +34,21 @@ TEST(CurveBundleAdjustment, MotionPriorTiesEachConsecutivePairOnlyWhenOnAndGiven
   EXPECT_THROW(buildCurveBundleAdjustment(input, {}), CheckError);
 }
 
+TEST(CurveBundleAdjustment, StartPriorTiesEveryKeyframeOnlyWhenOnAndGiven) {
+  CurveSceneOptions scene_options;
+  scene_options.num_keyframes = 4;
+  const CurveScene scene = makeCurveScene(scene_options);
+  CurveBundleAdjustmentInput input = makeCurveBundleAdjustmentInput(scene);
+  CurveBundleAdjustmentOptions on;
+  on.start_prior = true;
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, on).graph, "camera_prior"), 0);
+  input.motion_prior_cam_from_world = scene.true_cam_from_world;
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, {}).graph, "camera_prior"), 0);
+  EXPECT_EQ(countFactors(buildCurveBundleAdjustment(input, on).graph, "camera_prior"), 4);
+  input.motion_prior_cam_from_world.pop_back();
+  EXPECT_THROW(buildCurveBundleAdjustment(input, on), CheckError);
+}
+
 TEST(CurveBundleAdjustment, HybridGraphKeepsPointsBesideCurvesWithTheirOwnNoise) {
   CurveSceneOptions scene_options;
   scene_options.num_keyframes = 3;
@@ -182,6 +197,12 @@ TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
   options = {};
   options.motion_prior_translation_sigma_rel = std::nan("");
   expectRejected(options, "motion_prior_translation_sigma_rel");
+  options = {};
+  options.start_prior_rotation_sigma_deg = -0.1;
+  expectRejected(options, "start_prior_rotation_sigma_deg");
+  options = {};
+  options.start_prior_centre_sigma_rel = 0.0;
+  expectRejected(options, "start_prior_centre_sigma_rel");
 }
 
 TEST(CurveBundleAdjustment, RejectsMismatchedFieldsAndObservationsOutOfRange) {

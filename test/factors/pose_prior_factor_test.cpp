@@ -35,6 +35,40 @@ TEST(PosePriorFactor, JacobianMatchesNumerical) {
   }
 }
 
+TEST(CameraPriorFactor, MeasuresRotationAndCentreOffsetsInSigmas) {
+  const Pose3 prior(so3::exp(Eigen::Vector3d(0.1, 0.2, -0.3)), Eigen::Vector3d(1, 2, 3));
+  const CameraPriorFactor factor(poseKey(0), prior, 0.5, 2.0);
+  Values values;
+  values.insert(poseKey(0), prior);
+  EXPECT_LT(factor.unwhitenedError(values).norm(), 1e-12);
+  // Turned about its own centre by 0.05 rad: only the rotation rows, 0.05 / 0.5 each.
+  const Eigen::Vector3d turn(0.05, 0, 0);
+  const Eigen::Quaterniond turned = so3::exp(turn) * prior.rotation();
+  const Pose3 rotated(turned, -(turned * prior.inverseTranslation()));
+  values.update(poseKey(0), rotated);
+  Vector6d expected;
+  expected << 0.1, 0, 0, 0, 0, 0;
+  EXPECT_LT((factor.unwhitenedError(values) - expected).norm(), 1e-12);
+  // Moved by (1, -2, 4) in world without turning: only the centre rows, in units of 2.
+  const Pose3 moved(prior.rotation(),
+                    -(prior.rotation() * (prior.inverseTranslation() + Eigen::Vector3d(1, -2, 4))));
+  values.update(poseKey(0), moved);
+  expected << 0, 0, 0, 0.5, -1, 2;
+  EXPECT_LT((factor.unwhitenedError(values) - expected).norm(), 1e-12);
+  EXPECT_THROW(CameraPriorFactor(poseKey(0), prior, 0.0, 1.0), CheckError);
+  EXPECT_THROW(CameraPriorFactor(poseKey(0), prior, 1.0, -1.0), CheckError);
+}
+
+TEST(CameraPriorFactor, JacobianMatchesNumerical) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 50; ++trial) {
+    const CameraPriorFactor factor(poseKey(0), randomPose(rng), 0.3, 1.5);
+    Values values;
+    values.insert(poseKey(0), randomPose(rng));
+    testing::expectJacobiansMatchNumerical(factor, values, 1e-5);
+  }
+}
+
 TEST(CameraDistanceFactor, MeasuresDistanceBetweenCentres) {
   // Centres at the origin and at (3, 4, 0): distance 5.
   const Pose3 a;

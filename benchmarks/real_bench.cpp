@@ -21,7 +21,7 @@
 // starts only) makes every such run lift and register its curves at that start's poses
 // (`run --diagnose-frontend-poses`), so a map and a start of different errors meet;
 // --noise-start-prior true gives every noise start's run `--ba-start-prior` at the noise's own
-// sigmas (a start known per pose to within them). A set with
+// sigmas (a start known per pose to within them) instead of the motion prior. A set with
 // ground-truth curves (Pavilion) also gets `curvesfm eval-map` on every curve run: precision and
 // recall of the curve map at 2 cm. curvesfm runs as a subprocess (--curvesfm, default the one built
 // beside this bench); a variant whose flags the executable does not list in its --help is skipped
@@ -821,10 +821,10 @@ Variant withStartPrior(Variant variant, const Start& start, const BenchOptions& 
   if (!options.noise_start_prior || start.kind != "noise" || variant.command != "run") {
     return variant;
   }
-  variant.flags.insert(
-      variant.flags.end(),
-      {"--ba-start-prior", "true", "--ba-start-prior-rotation", text(options.noise_rotation_deg),
-       "--ba-start-prior-centre", text(options.noise_spacing_fraction)});
+  variant.flags.insert(variant.flags.end(),
+                       {"--ba-start-prior", "true", "--ba-start-prior-rotation",
+                        text(options.noise_rotation_deg), "--ba-start-prior-centre",
+                        text(options.noise_spacing_fraction), "--ba-motion-prior", "false"});
   return variant;
 }
 
@@ -1098,7 +1098,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--noise-start-prior", options.noise_start_prior,
                  "Noise starts: run with --ba-start-prior at the noise's own sigmas (each pose "
-                 "known to within them)")
+                 "known to within them) instead of the motion prior")
       ->capture_default_str();
   app.add_option_function<std::string>(
          "--map-at",

@@ -90,7 +90,10 @@ struct CurveBundleAdjustmentOptions {
   /// Tie each keyframe's orientation and centre to its pose in
   /// CurveBundleAdjustmentInput::motion_prior_cam_from_world (a CameraPriorFactor per keyframe):
   /// for a start whose poses are each known to within a rotation and a shift, independent per
-  /// pose (a noisy start, GNSS/INS). Off by default: a start that drifts (odometry, the point
+  /// pose (a noisy start, GNSS/INS), normally with motion_prior off, since such a start's
+  /// consecutive motions are off by 1.4 x its noise (planar protocol, 0.1 deg per pose: refined /
+  /// start ATE median 3.15 x with the motion prior, 0.65 x with this prior alone;
+  /// docs/benchmarks.md, session 23). Off by default: a start that drifts (odometry, the point
   /// initialiser) is off by more than its local accuracy, and this prior would hold that drift.
   bool start_prior = false;
   /// Std dev per axis of that orientation (deg), and of that centre as a fraction of the prior

@@ -331,7 +331,7 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
               "between consecutive keyframes")
       .boolean("start_prior", "start-prior", &b->start_prior,
                "Tie each keyframe's orientation and centre to its initial pose (a start known "
-               "per pose to within the two sigmas below)")
+               "per pose to within the two sigmas below; then set --ba-motion-prior false)")
       .number("start_prior_rotation_sigma_deg", "start-prior-rotation",
               &b->start_prior_rotation_sigma_deg,
               "Std dev per axis of each keyframe's initial orientation (deg)")

@@ -65,7 +65,8 @@ void printProgress(const KeyframeStats& s, int frames) {
   std::fflush(stdout);
 }
 
-std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const RunInput& input) {
+std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const RunInput& input,
+                                      const std::vector<Pose3>& frontend_poses) {
   std::vector<KeyframeStats> stats;
   const int n = static_cast<int>(input.frames.size());
   if (input.initialisation) {
@@ -79,11 +80,33 @@ std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const RunInput& input)
         {frame.timestamp, loadFrameImage(frame, input.sequence.camera),
          frame.initial_cam_from_world,
          input.sightings.empty() ? std::vector<PointSighting>{} : input.sightings[i],
-         input.frontend_poses.empty() ? std::optional<Pose3>() : input.frontend_poses[i]});
+         frontend_poses.empty() ? std::optional<Pose3>() : frontend_poses[i]});
     if (s.keyframe_index >= 0) printProgress(s, n);
     stats.push_back(s);
   }
   return stats;
+}
+
+// Per frame of `input`, the pose a relift pass lifts its map at: the keyframe's refined pose in
+// `previous`, else the pose the previous pass worked at (the keyframes are chosen on the initial
+// poses, so every pass has the same ones and the other frames only pass through).
+std::vector<Pose3> reliftPoses(const RunInput& input, const std::vector<Pose3>& previous_frontend,
+                               const PipelineResult& previous) {
+  std::map<double, Pose3> refined;
+  for (std::size_t k = 0; k < previous.keyframe_timestamps.size(); ++k) {
+    refined.emplace(previous.keyframe_timestamps[k], previous.keyframe_cam_from_world[k]);
+  }
+  std::vector<Pose3> poses;
+  for (std::size_t i = 0; i < input.frames.size(); ++i) {
+    const auto it = refined.find(input.frames[i].timestamp);
+    if (it != refined.end()) {
+      poses.push_back(it->second);
+    } else {
+      poses.push_back(previous_frontend.empty() ? input.frames[i].initial_cam_from_world
+                                                : previous_frontend[i]);
+    }
+  }
+  return poses;
 }
 
 // ATE (Sim(3)) of the initial and refined keyframe trajectories, when there is a ground truth.
@@ -107,6 +130,16 @@ AteResult evaluateAte(const PipelineResult& r, const ImageSequence& d) {
     ate.problem = e.what();
   }
   return ate;
+}
+
+void printReliftPass(int pass, int passes, const AteResult& ate) {
+  if (ate.refined) {
+    std::printf("relift %d of %d: lifting the curves again at the refined poses (ATE %.6f)\n", pass,
+                passes, ate.refined->ate.rmse);
+  } else {
+    std::printf("relift %d of %d: lifting the curves again at the refined poses\n", pass, passes);
+  }
+  std::fflush(stdout);
 }
 
 // How far one stage moved the keyframe poses from the start (Sim(3)-aligned camera centres, pose
@@ -654,6 +687,11 @@ RunCommand::RunCommand(CLI::App* app) {
                 "Diagnosis: lift and register curves at these poses (TUM or COLMAP model, in the "
                 "initial poses' frame and unit, e.g. the ground truth beside a perturbed copy of "
                 "it), then start global BA from the initial poses");
+  c->add_option("--relift-passes", relift_passes_,
+                "After the run, this many more, each lifting and registering the curves again at "
+                "the previous one's refined poses, with BA started from and its priors tied to "
+                "the initial poses (each pass costs a run)")
+      ->capture_default_str();
   c->add_flag("--overlays", overlays_,
               "Write OUT/overlays/NNNNNN.png, the final curves drawn on keyframe NNNNNN coloured "
               "by --overlay-colour-by with a legend, and OUT/worst_curves/: the 10 curves of "
@@ -688,6 +726,8 @@ void RunCommand::validate() const {
   require(export_min_epipolar_angle_deg_ >= 0.0 && export_min_epipolar_angle_deg_ < 90.0,
           "export-min-epipolar-angle", export_min_epipolar_angle_deg_, "in [0, 90)");
   require(max_dt_ >= 0.0 && max_dt_ < 1e6, "max-dt", max_dt_, "finite and >= 0");
+  require(relift_passes_ >= 0 && relift_passes_ <= 100, "relift-passes", relift_passes_,
+          "in [0, 100]");
   require(progress_interval_s_ >= 0.0 && progress_interval_s_ < 1e6, "progress-interval",
           progress_interval_s_, "finite and >= 0");
 }
@@ -700,6 +740,7 @@ nlohmann::json RunCommand::runOptionsJson() const {
   options["progress_interval_s"] = progress_interval_s_;
   options["points_at_given_poses"] = points_at_given_poses_;
   options["diagnose_frontend_poses"] = frontend_poses_path_;
+  options["relift_passes"] = relift_passes_;
   return options;
 }
 
@@ -779,9 +820,17 @@ int RunCommand::run() const {
 
   PipelineOptions options = options_;
   options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
-  Pipeline pipeline(d.camera, options);
-  feedFrames(&pipeline, input);
-  const PipelineResult result = pipeline.finish();
+  auto pipeline = std::make_unique<Pipeline>(d.camera, options);
+  feedFrames(pipeline.get(), input, input.frontend_poses);
+  PipelineResult result = pipeline->finish();
+  std::vector<Pose3> frontend_poses = input.frontend_poses;
+  for (int pass = 1; pass <= relift_passes_; ++pass) {
+    printReliftPass(pass, relift_passes_, evaluateAte(result, d));
+    frontend_poses = reliftPoses(input, frontend_poses, result);
+    pipeline = std::make_unique<Pipeline>(d.camera, options);
+    feedFrames(pipeline.get(), input, frontend_poses);
+    result = pipeline->finish();
+  }
   const AteResult ate = evaluateAte(result, d);
   const std::vector<StageMotion> motions = stageMotions(result, d);
 
@@ -805,7 +854,7 @@ int RunCommand::run() const {
   int overlays = 0;
   int worst_curve_images = 0;
   if (overlays_) {
-    const OverlayScene scene = overlayScene(pipeline, result);
+    const OverlayScene scene = overlayScene(*pipeline, result);
     overlays = writeOverlays(joinPath(out_dir_, "overlays"), scene, overlay_,
                              overlay_colouring_.colour_by);
     worst_curve_images = writeWorstCurves(joinPath(out_dir_, "worst_curves"), scene, overlay_);
@@ -831,7 +880,7 @@ int RunCommand::run() const {
          {"frames_with_initial_pose", input.frames.size()}}},
        {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
                                             : nlohmann::json(nullptr)},
-       {"camera", cameraToJson(pipeline.undistortedCamera())},
+       {"camera", cameraToJson(pipeline->undistortedCamera())},
        {"scene_scale", result.scene_scale},
        {"counts",
         {{"frames", input.frames.size()},

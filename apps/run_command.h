@@ -62,6 +62,11 @@ class RunCommand {
   /// keyframes' depth ranges and for --ba-points, as the initialiser's own run has.
   bool points_at_given_poses_ = true;
   std::string frontend_poses_path_;  // Diagnosis: --diagnose-frontend-poses.
+  /// After the run, this many more runs, each lifting and registering the map again at the
+  /// previous run's refined keyframe poses while its BA starts from, and its priors tie to, the
+  /// initial poses (as --diagnose-frontend-poses does): a map lifted at noisy poses carries
+  /// their errors, one lifted at better poses carries less. >= 0.
+  int relift_passes_ = 0;
   ImageSequenceOptions sequence_;
   PointInitialiserOptions initialiser_;
   PipelineOptions options_;

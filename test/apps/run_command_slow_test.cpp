@@ -149,6 +149,45 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
 // The fit checks after global BA: with a residual bound no curve meets, every curve of the global
 // map is found implausible for its residual, dropped and counted under its reason, and a run
 // left with nothing plausible says so and fails.
+TEST_F(RunCommandTest, AReliftPassLiftsTheMapAtTheRefinedPosesAndStartsBaFromTheInitialOnes) {
+  // Every frame is a keyframe. The relift pass's incremental stage works at the first run's
+  // refined poses, so its move from the start is the first run's final move; its BA then starts
+  // from the initial poses, which trajectory_initial.txt keeps.
+  const std::string dataset = writeShortPlanarDataset();
+  const std::string flags = shortPlanarFlags() + " --threads 1 --ba-motion-prior false";
+  const auto runInto = [&](const std::string& out, const std::string& extra) {
+    const CommandResult r =
+        runCurvesfm("run --dataset " + dataset + " --out " + path(out) + flags + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream report_file(path(out + "/report.json"));
+    return std::make_pair(r, nlohmann::json::parse(report_file));
+  };
+  const auto [first_output, first] = runInto("first", "");
+  const auto [relift_output, relift] = runInto("relift", " --relift-passes 1");
+  EXPECT_THAT(relift_output.output,
+              HasSubstr("relift 1 of 1: lifting the curves again at the refined poses (ATE "));
+  EXPECT_EQ(relift["options"]["relift_passes"], 1);
+
+  const nlohmann::json& first_final = first["pose_stages"].back();
+  const nlohmann::json& relift_start = relift["pose_stages"].front();
+  ASSERT_EQ(relift_start["stage"], "incremental");
+  const double moved = first_final["moved_rmse"].get<double>();
+  ASSERT_GT(moved, 0.0);
+  EXPECT_NEAR(relift_start["moved_rmse"].get<double>(), moved, 1e-6 * moved);
+  EXPECT_LT(first["pose_stages"].front()["moved_rmse"].get<double>(), 1e-9 * moved);
+
+  const std::vector<StampedPose> initial = readTrajectory(path("first/trajectory_initial.txt"));
+  const std::vector<StampedPose> relift_initial =
+      readTrajectory(path("relift/trajectory_initial.txt"));
+  ASSERT_EQ(relift_initial.size(), initial.size());
+  for (std::size_t i = 0; i < initial.size(); ++i) {
+    EXPECT_LT(
+        (relift_initial[i].world_from_cam.translation() - initial[i].world_from_cam.translation())
+            .norm(),
+        1e-9);
+  }
+}
+
 TEST_F(RunCommandTest, FitChecksDropCurvesThatDoNotFitTheirViews) {
   const std::string dataset = writeShortPlanarDataset();
   const std::string out = path("fit_out");

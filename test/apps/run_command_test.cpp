@@ -147,6 +147,9 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   result = run("--export-min-epipolar-angle 90");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("export-min-epipolar-angle = 90: in [0, 90)"));
+  result = run("--relift-passes -1");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("relift-passes = -1: in [0, 100]"));
   result = run("--sanity-min-epipolar-angle -1");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--sanity-min-epipolar-angle = -1: in [0, 90) "

@@ -121,7 +121,8 @@ struct BenchOptions {
   double noise_spacing_fraction = 0.01;
   double noise_rotation_deg = 0.1;  ///< Rotation per axis of a noise start (deg).
   /// Tell each noise start's run how its poses were perturbed: `run --ba-start-prior` at the
-  /// noise's own sigmas (a start known per pose to within them).
+  /// noise's own sigmas (a start known per pose to within them) and no motion prior, whose model
+  /// (accurate consecutive motions) such a start does not follow.
   bool noise_start_prior = false;
   /// Diagnosis: the start ("truth" or "noiseN") whose poses lift and register every curve of
   /// the truth and noise runs (`run --diagnose-frontend-poses`), so that a map and a start of
@@ -811,7 +812,10 @@ Variant withMapAt(Variant variant, const ImageSequence& sequence, const BenchOpt
 }
 
 /// With --noise-start-prior, a noise start's run holds each pose to its start at the noise's
-/// sigmas (the rotation per axis, and the shift as a fraction of the camera spacing).
+/// sigmas (the rotation per axis, and the shift as a fraction of the camera spacing: the median
+/// of all frames here, the mean of the keyframes' in `run`, the same when every frame is a
+/// keyframe) and drops the motion prior: independent errors per pose put each consecutive motion
+/// 1.4 x the noise off, which the motion prior (0.02 deg by default) would hold.
 Variant withStartPrior(Variant variant, const Start& start, const BenchOptions& options) {
   const auto text = [](double value) {
     char buffer[32];

@@ -820,13 +820,14 @@ int RunCommand::run() const {
 
   PipelineOptions options = options_;
   options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
-  auto pipeline = std::make_unique<Pipeline>(d.camera, options);
-  feedFrames(pipeline.get(), input, input.frontend_poses);
-  PipelineResult result = pipeline->finish();
+  std::unique_ptr<Pipeline> pipeline;
+  PipelineResult result;
   std::vector<Pose3> frontend_poses = input.frontend_poses;
-  for (int pass = 1; pass <= relift_passes_; ++pass) {
-    printReliftPass(pass, relift_passes_, evaluateAte(result, d));
-    frontend_poses = reliftPoses(input, frontend_poses, result);
+  for (int pass = 0; pass <= relift_passes_; ++pass) {
+    if (pass > 0) {
+      printReliftPass(pass, relift_passes_, evaluateAte(result, d));
+      frontend_poses = reliftPoses(input, frontend_poses, result);
+    }
     pipeline = std::make_unique<Pipeline>(d.camera, options);
     feedFrames(pipeline.get(), input, frontend_poses);
     result = pipeline->finish();

@@ -817,18 +817,14 @@ Variant withMapAt(Variant variant, const ImageSequence& sequence, const BenchOpt
 /// keyframe) and drops the motion prior: independent errors per pose put each consecutive motion
 /// 1.4 x the noise off, which the motion prior (0.02 deg by default) would hold.
 Variant withStartPrior(Variant variant, const Start& start, const BenchOptions& options) {
-  const auto text = [](double value) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof(buffer), "%.10g", value);
-    return std::string(buffer);
-  };
   if (!options.noise_start_prior || start.kind != "noise" || variant.command != "run") {
     return variant;
   }
-  variant.flags.insert(variant.flags.end(),
-                       {"--ba-start-prior", "true", "--ba-start-prior-rotation",
-                        text(options.noise_rotation_deg), "--ba-start-prior-centre",
-                        text(options.noise_spacing_fraction), "--ba-motion-prior", "false"});
+  variant.flags.insert(
+      variant.flags.end(),
+      {"--ba-start-prior", "true", "--ba-start-prior-rotation",
+       formatNumber(options.noise_rotation_deg, "%.10g"), "--ba-start-prior-centre",
+       formatNumber(options.noise_spacing_fraction, "%.10g"), "--ba-motion-prior", "false"});
   return variant;
 }
 

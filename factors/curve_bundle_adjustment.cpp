@@ -84,13 +84,18 @@ void addPoints(const CurveBundleAdjustmentInput& input, const CurveBundleAdjustm
   }
 }
 
+// The length unit of the priors' translation sigmas: the prior trajectory's mean step. One that
+// never moves still gets a usable sigma: it pins the translations at zero.
+double priorStep(const std::vector<Pose3>& prior_cam_from_world) {
+  return std::max(meanCameraStep(prior_cam_from_world), 1e-12);
+}
+
 void addMotionPrior(const std::vector<Pose3>& prior_cam_from_world,
                     const CurveBundleAdjustmentOptions& options, FactorGraph* graph) {
   if (prior_cam_from_world.size() < 2) return;
   const double rotation_sigma = options.motion_prior_rotation_sigma_deg * M_PI / 180.0;
-  // A trajectory that never moves still gets a usable sigma: it pins the translations at zero.
-  const double translation_sigma = options.motion_prior_translation_sigma_rel *
-                                   std::max(meanCameraStep(prior_cam_from_world), 1e-12);
+  const double translation_sigma =
+      options.motion_prior_translation_sigma_rel * priorStep(prior_cam_from_world);
   for (std::size_t j = 1; j < prior_cam_from_world.size(); ++j) {
     const Pose3 cam_j_from_cam_i = prior_cam_from_world[j] * prior_cam_from_world[j - 1].inverse();
     graph->emplace<RelativePoseFactor>(poseKey(j - 1), poseKey(j), cam_j_from_cam_i, rotation_sigma,
@@ -102,7 +107,7 @@ void addStartPrior(const std::vector<Pose3>& prior_cam_from_world,
                    const CurveBundleAdjustmentOptions& options, FactorGraph* graph) {
   const double rotation_sigma = options.start_prior_rotation_sigma_deg * M_PI / 180.0;
   const double centre_sigma =
-      options.start_prior_centre_sigma_rel * std::max(meanCameraStep(prior_cam_from_world), 1e-12);
+      options.start_prior_centre_sigma_rel * priorStep(prior_cam_from_world);
   for (std::size_t j = 0; j < prior_cam_from_world.size(); ++j) {
     graph->emplace<CameraPriorFactor>(poseKey(static_cast<int>(j)), prior_cam_from_world[j],
                                       rotation_sigma, centre_sigma);
@@ -189,17 +194,13 @@ CurveBundleAdjustmentProblem buildCurveBundleAdjustment(
   if (options.fix_scale) {
     addScaleGauge(input.cam_from_world, input.scale_distance, options.scale_sigma, &problem.graph);
   }
-  if (options.motion_prior && !input.motion_prior_cam_from_world.empty()) {
-    CURVESFM_CHECK(input.motion_prior_cam_from_world.size() == input.cam_from_world.size())
-        << "curve bundle adjustment: " << input.motion_prior_cam_from_world.size()
-        << " motion-prior poses for " << num_keyframes << " keyframes";
-    addMotionPrior(input.motion_prior_cam_from_world, options, &problem.graph);
-  }
-  if (options.start_prior && !input.motion_prior_cam_from_world.empty()) {
-    CURVESFM_CHECK(input.motion_prior_cam_from_world.size() == input.cam_from_world.size())
-        << "curve bundle adjustment: " << input.motion_prior_cam_from_world.size()
-        << " start-prior poses for " << num_keyframes << " keyframes";
-    addStartPrior(input.motion_prior_cam_from_world, options, &problem.graph);
+  const std::vector<Pose3>& prior = input.motion_prior_cam_from_world;
+  if ((options.motion_prior || options.start_prior) && !prior.empty()) {
+    CURVESFM_CHECK(prior.size() == input.cam_from_world.size())
+        << "curve bundle adjustment: " << prior.size() << " prior poses for " << num_keyframes
+        << " keyframes";
+    if (options.motion_prior) addMotionPrior(prior, options, &problem.graph);
+    if (options.start_prior) addStartPrior(prior, options, &problem.graph);
   }
   return problem;
 }

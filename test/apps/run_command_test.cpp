@@ -134,6 +134,11 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   EXPECT_THAT(result.output,
               HasSubstr("--ba-motion-prior-translation = -0.1: must be > 0 and finite "
                         "(CurveBundleAdjustmentOptions.motion_prior_translation_sigma_rel)"));
+  result = run("--ba-start-prior-centre 0");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output,
+              HasSubstr("--ba-start-prior-centre = 0: must be > 0 and finite "
+                        "(CurveBundleAdjustmentOptions.start_prior_centre_sigma_rel)"));
   // The same struct in two places: the error names the place's flag.
   result = run("--global-ba-max-rounds 0");
   EXPECT_EQ(result.exit_code, 2);

@@ -111,6 +111,16 @@ std::string checkPlotExtension(std::string& path) {
   return "'" + path + "': expected a file name ending in .png or .pdf";
 }
 
+// Every estimated pose, matched or not, so that the file replaces the estimate one for one.
+void writeAlignedEstimate(const std::string& path, const std::vector<StampedPose>& estimate,
+                          const Sim3& ground_truth_from_estimate) {
+  std::vector<StampedPose> aligned = estimate;
+  for (StampedPose& pose : aligned)
+    pose.world_from_cam = ground_truth_from_estimate.transformPose(pose.world_from_cam);
+  writeTrajectory(path, aligned);
+  std::printf("aligned estimate: %s\n", path.c_str());
+}
+
 }  // namespace
 
 EvalCommand::EvalCommand(CLI::App* app) {
@@ -133,6 +143,9 @@ EvalCommand::EvalCommand(CLI::App* app) {
                 "Draw a PNG or PDF (by extension): top view of both trajectories (left) and the "
                 "ATE over time (right), with python3 -m curvesfm_plots eval")
       ->check(CLI::Validator(checkPlotExtension, "FILE.png|FILE.pdf"));
+  c->add_option("--aligned-out", aligned_path_,
+                "Write every estimated pose carried into the ground truth's world by the "
+                "alignment, as a TUM trajectory (e.g. an aligned start for `run --init-poses`)");
 }
 
 int EvalCommand::run() const {
@@ -143,6 +156,8 @@ int EvalCommand::run() const {
 
   printSummary(evaluation);
   printStatistics(evaluation);
+  if (!aligned_path_.empty())
+    writeAlignedEstimate(aligned_path_, estimate, evaluation.ground_truth_from_estimate);
 
   // The figure is drawn from the JSON, so --plot writes it too, to a temporary file without --json.
   std::optional<TemporaryFile> temporary_json;

@@ -11,7 +11,9 @@ namespace curvesfm {
 /// `curvesfm eval`: compares an estimated TUM trajectory with the ground truth: associates the
 /// poses by timestamp, aligns the estimate (sim3, se3 or none) and prints the ATE and RPE
 /// statistics; optionally writes them as JSON and draws the trajectories and the error as a PNG
-/// or PDF (`--plot`, by `python3 -m curvesfm_plots eval` from that JSON: apps/cli/plot_scripts.h).
+/// or PDF (`--plot`, by `python3 -m curvesfm_plots eval` from that JSON: apps/cli/plot_scripts.h),
+/// and writes the aligned estimate as a TUM trajectory (`--aligned-out`), which can be given back
+/// to `run` as initial poses in the ground truth's frame.
 class EvalCommand {
  public:
   explicit EvalCommand(CLI::App* app);
@@ -32,6 +34,7 @@ class EvalCommand {
   OptionsTable table_;  ///< Rows point into options_: the command is not copied.
   std::string json_path_;
   std::string plot_path_;
+  std::string aligned_path_;
 };
 
 }  // namespace curvesfm

@@ -90,6 +90,26 @@ TEST_F(EvalCommandTest, PrintsMatchesAteAndRpeAndWritesJsonAndPlot) {
   EXPECT_EQ(plot.rows, 600);
 }
 
+TEST_F(EvalCommandTest, AlignedOutCarriesEveryEstimatedPoseOntoTheGroundTruth) {
+  const std::string gt = writeCircle("gt.txt", 40, 1.0);
+  // Five poses past the ground truth's end: unmatched, yet written, so that the file can stand
+  // in for the estimate.
+  const std::string est = writeCircle("est.txt", 45, 0.5);
+  const CommandResult result =
+      runCurvesfm("eval --est " + est + " --gt " + gt + " --aligned-out " + path("aligned.txt"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, ::testing::HasSubstr("aligned estimate: " + path("aligned.txt")));
+
+  const CommandResult again = runCurvesfm("eval --est " + path("aligned.txt") + " --gt " + gt +
+                                          " --align none --json " + path("again.json"));
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_THAT(again.output, ::testing::HasSubstr("matched 40 of 45 estimated poses"));
+  std::ifstream json_file(path("again.json"));
+  const nlohmann::json report = nlohmann::json::parse(json_file);
+  EXPECT_LT(report["ate_m"]["max"].get<double>(), 1e-4);
+  EXPECT_LT(report["rpe_rotation_deg"]["max"].get<double>(), 1e-3);
+}
+
 TEST_F(EvalCommandTest, PlotWithoutJsonWritesAPdf) {
   const std::string gt = writeCircle("gt.txt", 20, 1.0);
   const CommandResult result =

@@ -110,6 +110,16 @@ TEST_F(EvalCommandTest, AlignedOutCarriesEveryEstimatedPoseOntoTheGroundTruth) {
   EXPECT_LT(report["rpe_rotation_deg"]["max"].get<double>(), 1e-3);
 }
 
+TEST_F(EvalCommandTest, AlignedOutInAMissingFolderExitsWithOneLineNamingIt) {
+  const std::string gt = writeCircle("gt.txt", 10, 1.0);
+  const std::string target = path("missing/aligned.txt");
+  const CommandResult result =
+      runCurvesfm("eval --est " + gt + " --gt " + gt + " --aligned-out " + target);
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.output,
+              ::testing::EndsWith("IoError: " + target + ": cannot open for writing\n"));
+}
+
 TEST_F(EvalCommandTest, PlotWithoutJsonWritesAPdf) {
   const std::string gt = writeCircle("gt.txt", 20, 1.0);
   const CommandResult result =

@@ -438,7 +438,7 @@ double medianSpacing(const std::vector<StampedPose>& poses) {
 }
 
 /// `truth` with every pose perturbed on its own: a world-frame shift of the camera centre and a
-/// world-frame rotation, Gaussian per axis (Pose3::retract).
+/// world-frame rotation about the centre, Gaussian per axis (perturbCamera).
 std::vector<StampedPose> noisyStart(const std::vector<StampedPose>& truth,
                                     const BenchOptions& options, int seed) {
   std::mt19937 rng(static_cast<std::uint32_t>(seed));
@@ -450,7 +450,7 @@ std::vector<StampedPose> noisyStart(const std::vector<StampedPose>& truth,
     Vector6d delta;
     for (int k = 0; k < 3; ++k) delta(k) = rotation(rng);
     for (int k = 3; k < 6; ++k) delta(k) = shift(rng);
-    noisy.push_back({p.timestamp, p.world_from_cam.retract(delta)});
+    noisy.push_back({p.timestamp, perturbCamera(p.world_from_cam, delta)});
   }
   return noisy;
 }

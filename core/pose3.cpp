@@ -28,21 +28,21 @@ Pose3 Pose3::inverse() const {
 Eigen::Vector3d Pose3::transformPoint(const Eigen::Vector3d& point, Matrix36d* H_pose,
                                       Eigen::Matrix3d* H_point) const {
   const Eigen::Matrix3d R = rotationMatrix();
-  const Eigen::Vector3d rotated = R * point;
+  const Eigen::Vector3d transformed = R * point + translation_;
   if (H_pose) {
-    // d(exp(w) R p)/dw at w = 0 is -[R p]x; the translation enters with identity.
-    H_pose->leftCols<3>() = -so3::hat(rotated);
+    // d(exp(w) x + u)/d[w; u] at 0 with x = R p + t: [-[x]x, I].
+    H_pose->leftCols<3>() = -so3::hat(transformed);
     H_pose->rightCols<3>().setIdentity();
   }
   if (H_point) *H_point = R;
-  return rotated + translation_;
+  return transformed;
 }
 
 Eigen::Vector3d Pose3::inverseTranslation(Matrix36d* H_pose) const {
   const Eigen::Matrix3d Rt = rotationMatrix().transpose();
   if (H_pose) {
-    // c = -R^T t; with R -> exp(w) R, R^T -> R^T (I - [w]x), so dc/dw = -R^T [t]x.
-    H_pose->leftCols<3>() = -Rt * so3::hat(translation_);
+    // c' = -R^T exp(-w) (exp(w) t + u) = c - R^T exp(-w) u: the rotation leaves c in place.
+    H_pose->leftCols<3>().setZero();
     H_pose->rightCols<3>() = -Rt;
   }
   return -(Rt * translation_);
@@ -62,24 +62,30 @@ Vector6d Pose3::log() const {
 }
 
 Pose3 Pose3::retract(const Vector6d& delta) const {
-  return Pose3(so3::exp(delta.head<3>()) * rotation_, translation_ + delta.tail<3>());
+  const Eigen::Quaterniond turn = so3::exp(delta.head<3>());
+  return Pose3(turn * rotation_, turn * translation_ + delta.tail<3>());
 }
 
 Vector6d Pose3::localCoordinates(const Pose3& other, Matrix6d* H_this, Matrix6d* H_other) const {
+  // The left motion P = other * this^-1 = (R_p, t_p); delta = [log(R_p); t_p].
+  const Eigen::Quaterniond rotation = other.rotation_ * rotation_.conjugate();
+  const Eigen::Vector3d shift = other.translation_ - rotation * translation_;
   Vector6d delta;
-  const Eigen::Vector3d w = so3::log(other.rotation_ * rotation_.conjugate());
-  delta.head<3>() = w;
-  delta.tail<3>() = other.translation_ - translation_;
+  const Eigen::Vector3d w = so3::log(rotation);
+  delta << w, shift;
   if (H_this) {
-    // log(R_o R^T exp(-d)) ~= w - JrInv(w) d.
+    // this -> (exp(d), e) this turns P into P (exp(d), e)^-1 ~= (R_p exp(-d), t_p - R_p e), and
+    // log(R_p exp(-d)) ~= w - JrInv(w) d.
     H_this->setZero();
     H_this->topLeftCorner<3, 3>() = -so3::rightJacobianInverse(w);
-    H_this->bottomRightCorner<3, 3>() = -Eigen::Matrix3d::Identity();
+    H_this->bottomRightCorner<3, 3>() = -rotation.toRotationMatrix();
   }
   if (H_other) {
-    // log(exp(d) R_o R^T) ~= w + JlInv(w) d.
+    // other -> (exp(d), e) other turns P into (exp(d) R_p, exp(d) t_p + e), and
+    // log(exp(d) R_p) ~= w + JlInv(w) d, exp(d) t_p ~= t_p - [t_p]x d.
     H_other->setZero();
     H_other->topLeftCorner<3, 3>() = so3::leftJacobianInverse(w);
+    H_other->bottomLeftCorner<3, 3>() = -so3::hat(shift);
     H_other->bottomRightCorner<3, 3>().setIdentity();
   }
   return delta;
@@ -92,6 +98,11 @@ void Pose3::toAmbient(double* out) const {
 
 Pose3 Pose3::fromAmbient(const double* in) {
   return Pose3(Eigen::Quaterniond(in[3], in[0], in[1], in[2]), Eigen::Vector3d(in[4], in[5], in[6]));
+}
+
+Pose3 perturbCamera(const Pose3& world_from_cam, const Vector6d& delta) {
+  return Pose3(so3::exp(delta.head<3>()) * world_from_cam.rotation(),
+               world_from_cam.translation() + delta.tail<3>());
 }
 
 double cameraCentreDistance(const Pose3& a_cam_from_world, const Pose3& b_cam_from_world) {

@@ -12,8 +12,11 @@ namespace curvesfm {
 /// Name variables after the frames they map, e.g. `cam_from_world`, `world_from_cam`.
 ///
 /// Tangent space (the chart used by the optimiser and all Jacobians), delta = [w; u]:
-///   retract(delta) = (exp(w) * R, t + u)
-/// i.e. a rotation perturbation on the left (in the target frame) and an additive translation.
+///   retract(delta) = (exp(w), u) * (R, t) = (exp(w) * R, exp(w) * t + u)
+/// i.e. a rigid motion of the target frame applied on the left. For `cam_from_world` the rotation
+/// turns the camera about its own centre and u shifts it in its own frame, so the chart, and with
+/// it every solver step, does not depend on where the source (world) frame's origin lies: a
+/// world frame moved rigidly gives the same steps (g2o's and Sophus' left update).
 /// Ambient storage for solvers: 7 doubles [qx, qy, qz, qw, tx, ty, tz] (Eigen's order), qw >= 0.
 class Pose3 {
  public:
@@ -39,8 +42,8 @@ class Pose3 {
                                  Eigen::Matrix3d* H_point = nullptr) const;
   Eigen::Vector3d operator*(const Eigen::Vector3d& point) const { return transformPoint(point); }
 
-  /// Position of the source frame's origin expressed in the target frame after inversion,
-  /// i.e. for `cam_from_world` the camera centre in world: -R^T t. Optional H_pose (3x6).
+  /// Position of the target frame's origin in the source frame, i.e. for `cam_from_world` the
+  /// camera centre in world: -R^T t. Optional H_pose (3x6; 0 in w: the chart turns about it).
   Eigen::Vector3d inverseTranslation(Matrix36d* H_pose = nullptr) const;
 
   /// SE(3) group exponential of xi = [w; v] (rotation vector, translational velocity).
@@ -63,6 +66,10 @@ class Pose3 {
   Eigen::Quaterniond rotation_;
   Eigen::Vector3d translation_;
 };
+
+/// `world_from_cam` turned by exp(w) about its own centre and its centre shifted by u, both in
+/// world axes, delta = [w; u]: (exp(w) R, t + u). The perturbed starts of the benches.
+Pose3 perturbCamera(const Pose3& world_from_cam, const Vector6d& delta);
 
 /// Distance between the camera centres of two cam_from_world poses (their unit).
 double cameraCentreDistance(const Pose3& a_cam_from_world, const Pose3& b_cam_from_world);

@@ -86,7 +86,7 @@ CurveReprojectionFactor::CurveReprojectionFactor(Key pose_key, const SegmentKeys
 
 // Per-sample intermediate results of one evaluation, on the stack.
 struct CurveReprojectionFactor::SampleBatch {
-  std::array<Eigen::Vector3d, kMaxSamples> rotated;  // R * B(t_k)
+  std::array<Eigen::Vector3d, kMaxSamples> in_cam;  // R * B(t_k) + t
   std::array<Eigen::Vector2d, kMaxSamples> pixel;
   std::array<Matrix23d, kMaxSamples> d_pixel_d_cam;
   std::array<const EdgePixel*, kMaxSamples> edge;  // null unless kOnField
@@ -196,9 +196,10 @@ void CurveReprojectionFactor::locateSamples(const Pose3& cam_from_world, const E
   const bool check_orientation = sampling_->sin_max_normal_angle < 1.0;
   SampleBatch& b = *batch;
   for (int k = 0; k < num_samples; ++k) {
-    b.rotated[k] = R * segment.evaluate(sampling_->point_weights.col(k));
+    b.in_cam[k] =
+        R * segment.evaluate(sampling_->point_weights.col(k)) + cam_from_world.translation();
     const bool in_front =
-        camera_->project(b.rotated[k] + cam_from_world.translation(), &b.pixel[k],
+        camera_->project(b.in_cam[k], &b.pixel[k],
                          with_jacobians || check_orientation ? &b.d_pixel_d_cam[k] : nullptr);
     b.outcome[k] = in_front ? SampleOutcome::kOnField : SampleOutcome::kBehindCamera;
     if (in_front) field_->prefetch(b.pixel[k][0], b.pixel[k][1]);
@@ -287,8 +288,8 @@ CurveReprojectionFactor::Error CurveReprojectionFactor::evaluateError(
     const Eigen::RowVector3d d_r_d_cam = batch.gradient[k].transpose() * batch.d_pixel_d_cam[k];
     const Eigen::RowVector3d d_r_d_point = d_r_d_cam * R;
     if (H_pose) {
-      // d(exp(w) R p + t + u)/d[w; u] = [-[R p]x, I], and -a^T [b]x = (b x a)^T.
-      H_pose->row(k).head<3>() = batch.rotated[k].cross(d_r_d_cam.transpose()).transpose();
+      // d(exp(w) x + u)/d[w; u] = [-[x]x, I] for x = R p + t, and -a^T [b]x = (b x a)^T.
+      H_pose->row(k).head<3>() = batch.in_cam[k].cross(d_r_d_cam.transpose()).transpose();
       H_pose->row(k).tail<3>() = d_r_d_cam;
     }
     if (H_q0) H_q0->row(k) = d_B.scale_q0 * d_r_d_point;

@@ -19,8 +19,7 @@ PointReprojectionFactor::Error PointReprojectionFactor::evaluateError(
     const Pose3& cam_from_world, const Eigen::Vector3d& point_in_world, Jacobian<Pose3>* H_pose,
     Jacobian<Eigen::Vector3d>* H_point) const {
   const Eigen::Matrix3d R = cam_from_world.rotationMatrix();
-  const Eigen::Vector3d rotated = R * point_in_world;
-  const Eigen::Vector3d point_in_cam = rotated + cam_from_world.translation();
+  const Eigen::Vector3d point_in_cam = R * point_in_world + cam_from_world.translation();
   Eigen::Vector2d pixel;
   Matrix23d d_pixel_d_cam;
   const bool wants_jacobians = H_pose || H_point;
@@ -30,8 +29,8 @@ PointReprojectionFactor::Error PointReprojectionFactor::evaluateError(
     return Error::Constant(kBehindCameraError);
   }
   if (H_pose) {
-    // d(exp(w) R p + t + u)/d[w; u] = [-[R p]x, I].
-    H_pose->leftCols<3>().noalias() = -d_pixel_d_cam * so3::hat(rotated);
+    // d(exp(w) x + u)/d[w; u] = [-[x]x, I] for x = R p + t.
+    H_pose->leftCols<3>().noalias() = -d_pixel_d_cam * so3::hat(point_in_cam);
     H_pose->rightCols<3>() = d_pixel_d_cam;
   }
   if (H_point) H_point->noalias() = d_pixel_d_cam * R;

@@ -6,7 +6,8 @@
 namespace curvesfm {
 
 /// A prior on a pose, e.g. to anchor the gauge softly or to tie a pose to an external estimate:
-///   e = prior.localCoordinates(pose) = [log(R R_prior^T); t - t_prior]   (rad; scene units)
+///   e = prior.localCoordinates(pose) = [log(R R_prior^T); t - R R_prior^T t_prior]
+/// (rad; scene units); for cam_from_world the translation part is -R (c - c_prior), c = -R^T t.
 /// Key: one Pose3. Jacobian 6x6 w.r.t. the pose tangent. Put per-axis scaling of rotation vs
 /// translation into the noise model's sigma by choosing units; sigma is isotropic.
 class PosePriorFactor : public NoiseModelFactorN<6, Pose3> {
@@ -26,8 +27,8 @@ class PosePriorFactor : public NoiseModelFactorN<6, Pose3> {
 /// A prior on a camera's orientation and centre in world, each with its own std dev, e.g. a start
 /// whose poses are known to within a rotation and a shift per axis:
 ///   e = [log(R R_prior^T) / rotation_sigma; (c - c_prior) / centre_sigma],  c = -R^T t,
-/// already whitened (dimensionless; give it a NoiseModel of sigma 1). Unlike PosePriorFactor it
-/// holds the centre, not t = -R c, so a turn of the camera does not move its prior position.
+/// already whitened (dimensionless; give it a NoiseModel of sigma 1). Unlike PosePriorFactor its
+/// centre error is in world axes, so it can be weighted per world axis later.
 /// Key: one Pose3 (cam_from_world). Jacobian 6x6 w.r.t. the pose tangent.
 class CameraPriorFactor : public NoiseModelFactorN<6, Pose3> {
   using Base = NoiseModelFactorN<6, Pose3>;

@@ -27,21 +27,17 @@ RelativePoseFactor::Error RelativePoseFactor::evaluateError(const Pose3& cam_i_f
   if (!H_i && !H_j) return whitening_.asDiagonal() * measured_.localCoordinates(relative);
   Matrix6d d_error_d_relative;
   const Vector6d error = measured_.localCoordinates(relative, nullptr, &d_error_d_relative);
-  // relative's tangent under the poses' tangents [w; u] (left rotation, additive translation):
-  //   R_rel -> exp(w_j - R_rel w_i) R_rel,
-  //   t_rel -> t_rel + u_j - R_rel u_i + [R_rel t_i]x (w_j - R_rel w_i).
+  // relative = P_j cam_j_from_world cam_i_from_world^-1 P_i^-1 for the poses' left motions
+  // P = (exp(w), u); as a left motion of relative:
+  //   from P_j: [w_j; u_j] itself;
+  //   from P_i: [-R_rel w_i; -[t_rel]x R_rel w_i - R_rel u_i].
   const Eigen::Matrix3d R_rel = relative.rotationMatrix();
-  const Eigen::Matrix3d lever = so3::hat(R_rel * cam_i_from_world.translation());
   const Eigen::DiagonalMatrix<double, 6> whitening(whitening_);
-  if (H_j) {
-    Matrix6d d_relative = Matrix6d::Identity();
-    d_relative.bottomLeftCorner<3, 3>() = lever;
-    *H_j = whitening * d_error_d_relative * d_relative;
-  }
+  if (H_j) *H_j = whitening * d_error_d_relative;
   if (H_i) {
     Matrix6d d_relative = Matrix6d::Zero();
     d_relative.topLeftCorner<3, 3>() = -R_rel;
-    d_relative.bottomLeftCorner<3, 3>() = -lever * R_rel;
+    d_relative.bottomLeftCorner<3, 3>() = -so3::hat(relative.translation()) * R_rel;
     d_relative.bottomRightCorner<3, 3>() = -R_rel;
     *H_i = whitening * d_error_d_relative * d_relative;
   }

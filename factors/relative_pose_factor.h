@@ -10,8 +10,9 @@ namespace curvesfm {
 /// edge directions leave some pose directions weakly constrained (docs/benchmarks.md).
 ///   rel = cam_j_from_world * cam_i_from_world^-1        (cam_j_from_cam_i)
 ///   e   = W * measured.localCoordinates(rel),  W = diag(1/sigma_R (x3), 1/sigma_t (x3))
-/// so e = [log(R_rel R_meas^T) / sigma_R; (t_rel - t_meas) / sigma_t] is already whitened
-/// (dimensionless): give it a NoiseModel of sigma 1, with a kernel if wanted. sigma_R =
+/// so e = [log(R_rel R_meas^T) / sigma_R; (t_rel - R_rel R_meas^T t_meas) / sigma_t], whose
+/// translation part is -R_rel times the shift of camera j's centre seen from camera i, is already
+/// whitened (dimensionless): give it a NoiseModel of sigma 1, with a kernel if wanted. sigma_R =
 /// rotation_sigma (rad) and sigma_t = translation_sigma (scene units), both per axis.
 /// Keys: two Pose3 (cam_from_world). Jacobians 6x6 each, w.r.t. the pose tangents.
 class RelativePoseFactor : public NoiseModelFactorN<6, Pose3, Pose3> {

@@ -35,6 +35,8 @@ bool PoseManifold::PlusJacobian(const double* x, double* jacobian) const {
   Eigen::Map<Eigen::Matrix<double, 7, 6, Eigen::RowMajor>> J(jacobian);
   J.setZero();
   J.topLeftCorner<4, 3>() = quaternionPlusJacobian(x);
+  // t' = exp(w) t + u.
+  J.bottomLeftCorner<3, 3>() = -so3::hat(Eigen::Vector3d(x[4], x[5], x[6]));
   J.bottomRightCorner<3, 3>().setIdentity();
   return true;
 }
@@ -48,6 +50,9 @@ bool PoseManifold::MinusJacobian(const double* x, double* jacobian) const {
   Eigen::Map<Eigen::Matrix<double, 6, 7, Eigen::RowMajor>> J(jacobian);
   J.setZero();
   J.topLeftCorner<3, 4>() = 4.0 * quaternionPlusJacobian(x).transpose();
+  // u = t_y - exp(w) t_x ~= dt + [t]x w: the left inverse of PlusJacobian.
+  J.bottomLeftCorner<3, 4>() =
+      so3::hat(Eigen::Vector3d(x[4], x[5], x[6])) * J.topLeftCorner<3, 4>();
   J.bottomRightCorner<3, 3>().setIdentity();
   return true;
 }
@@ -98,7 +103,10 @@ void liftToAmbient(VariableType type, const double* x, const double* tangent_jac
           tangent_jacobian, rows, 6);
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> Ja(ambient_jacobian,
                                                                                rows, 7);
-      Ja.leftCols<4>().noalias() = Jt.leftCols<3>() * (4.0 * quaternionPlusJacobian(x).transpose());
+      // Ja = Jt * MinusJacobian(x), so that Ja * PlusJacobian(x) == Jt.
+      const Eigen::Matrix<double, 3, 4> dw_dq = 4.0 * quaternionPlusJacobian(x).transpose();
+      const Eigen::Matrix3d t_hat = so3::hat(Eigen::Vector3d(x[4], x[5], x[6]));
+      Ja.leftCols<4>().noalias() = (Jt.leftCols<3>() + Jt.rightCols<3>() * t_hat) * dw_dq;
       Ja.rightCols<3>() = Jt.rightCols<3>();
       return;
     }

@@ -7,7 +7,7 @@
 namespace curvesfm {
 
 /// Pose3's chart as a Ceres manifold. Ambient [qx qy qz qw tx ty tz], tangent [w; u]:
-/// Plus(x, d) = (exp(w) * q, t + u), exactly Pose3::retract.
+/// Plus(x, d) = (exp(w) * q, exp(w) * t + u), exactly Pose3::retract.
 class PoseManifold : public ceres::Manifold {
  public:
   int AmbientSize() const override { return 7; }

@@ -57,7 +57,7 @@ Vector6d poseNoise(const PlanarSceneOptions& options, std::mt19937& rng) {
 }
 
 Pose3 perturb(const Pose3& cam_from_world, const Vector6d& delta) {
-  return cam_from_world.inverse().retract(delta).inverse();
+  return perturbCamera(cam_from_world.inverse(), delta).inverse();
 }
 
 // The starting guess of every frame (see InitNoiseModel).

@@ -213,14 +213,41 @@ TEST(Pose3, RetractOfZeroIsIdentityMap) {
   EXPECT_EQ(pose.localCoordinates(pose), Vector6d::Zero());
 }
 
-TEST(Pose3, RetractPerturbsRotationOnTheLeftAndTranslationAdditively) {
+TEST(Pose3, RetractAppliesARigidMotionOfTheTargetFrameOnTheLeft) {
   std::mt19937 rng(13);
   for (int i = 0; i < kConfigurations; ++i) {
     const Pose3 pose = randomPose(rng);
     const Vector6d delta = randomTangent(rng, 1.0, 1.0);
-    const Pose3 moved = pose.retract(delta);
-    EXPECT_LE(moved.rotation().angularDistance(so3::exp(delta.head<3>()) * pose.rotation()), 1e-14);
-    EXPECT_LE((moved.translation() - pose.translation() - delta.tail<3>()).norm(), 1e-14);
+    expectPoseNear(pose.retract(delta),
+                   Pose3(so3::exp(delta.head<3>()), Eigen::Vector3d(delta.tail<3>())) * pose,
+                   1e-14);
+  }
+}
+
+// The optimiser's steps must not depend on where the world's origin lies: the same step taken
+// from a pose expressed in a world moved rigidly is the same camera motion.
+TEST(Pose3, RetractDoesNotDependOnTheSourceFrame) {
+  std::mt19937 rng(16);
+  for (int i = 0; i < kConfigurations; ++i) {
+    const Pose3 cam_from_world = randomPose(rng);
+    Pose3 world_from_moved = randomPose(rng);
+    world_from_moved = Pose3(world_from_moved.rotation(), 100.0 * world_from_moved.translation());
+    const Vector6d delta = randomTangent(rng, 1.0, 1.0);
+    expectPoseNear((cam_from_world * world_from_moved).retract(delta),
+                   cam_from_world.retract(delta) * world_from_moved, 1e-11);
+  }
+}
+
+TEST(Pose3, RetractTurnsACameraAboutItsOwnCentre) {
+  std::mt19937 rng(17);
+  for (int i = 0; i < kConfigurations; ++i) {
+    const Pose3 cam_from_world = randomPose(rng);
+    const Vector6d turn =
+        (Vector6d() << randomTangent(rng, 1.0, 0.0).head<3>(), 0, 0, 0).finished();
+    EXPECT_LE(
+        (cam_from_world.retract(turn).inverseTranslation() - cam_from_world.inverseTranslation())
+            .norm(),
+        1e-12);
   }
 }
 

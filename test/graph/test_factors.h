@@ -23,7 +23,7 @@ class AllTypesFactor : public NoiseModelFactorN<3, Pose3, Eigen::Vector3d, Direc
     const Eigen::Matrix3d R = pose.rotationMatrix();
     const Eigen::Vector3d local = point + scale * direction.vector();
     if (H_pose) {
-      H_pose->leftCols<3>() = -so3::hat(R * local);
+      H_pose->leftCols<3>() = -so3::hat(R * local + pose.translation());
       H_pose->rightCols<3>().setIdentity();
     }
     if (H_point) *H_point = R;
@@ -64,9 +64,9 @@ class TranslationDifferenceFactor : public NoiseModelFactorN<3, Pose3, Pose3> {
       : Base({a, b}, noise), target_(target) {}
   Error evaluateError(const Pose3& a, const Pose3& b, Jacobian<Pose3>* H_a,
                       Jacobian<Pose3>* H_b) const override {
-    // Pose3's chart moves the translation by the tangent's last three entries.
-    if (H_a) *H_a << Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Identity();
-    if (H_b) *H_b << Eigen::Matrix3d::Zero(), -Eigen::Matrix3d::Identity();
+    // Pose3's chart moves the translation to exp(w) t + u.
+    if (H_a) *H_a << -so3::hat(a.translation()), Eigen::Matrix3d::Identity();
+    if (H_b) *H_b << so3::hat(b.translation()), -Eigen::Matrix3d::Identity();
     return a.translation() - b.translation() - target_;
   }
   const char* typeName() const override { return "translation_difference"; }

@@ -43,6 +43,12 @@ TEST(RealBenchCommandLine, NamesADataFolderWithoutTheSets) {
   EXPECT_THAT(r.output, HasSubstr("none of the benchmark's sets is there"));
 }
 
+TEST(RealBenchCommandLine, RejectsAStartOriginOtherThanNativeOrFirst) {
+  const testing::CommandResult r = runRealBench("--start-origin centre");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--start-origin: centre not in {native,first}"));
+}
+
 TEST(RealBenchCommandLine, RejectsAMapAtLabelThatNamesNoStart) {
   for (const char* label : {"noise", "noise1x", "colmap", "noise12345678901234567890"}) {
     const testing::CommandResult r = runRealBench(std::string("--map-at ") + label);

@@ -23,14 +23,15 @@
 // --noise-start-prior true gives every noise start's run `--ba-start-prior` at the noise's own
 // sigmas (a start known per pose to within them) instead of the motion prior; --start-origin
 // first moves every start file's world origin to its first camera (a check that the refined
-// poses do not depend on the input's frame). A set with
-// ground-truth curves (Pavilion) also gets `curvesfm eval-map` on every curve run: precision and
-// recall of the curve map at 2 cm. curvesfm runs as a subprocess (--curvesfm, default the one built
-// beside this bench); a variant whose flags the executable does not list in its --help is skipped
-// with a note, so the table can name flags that a later curvesfm adds. Every trajectory (init:
-// every registered frame; curves and hybrid: the keyframes; COLMAP: every registered image) is
-// compared with the set's ground truth from loadImageSequence by compareTrajectories (Sim(3),
-// core/trajectory_evaluation.h).
+// poses do not depend on the input's frame); --start-jitter-seed S moves every start camera by
+// about 1e-6 camera spacings, which shows how far a single run's figures are from the next one's. A
+// set with ground-truth curves (Pavilion) also gets `curvesfm eval-map` on every curve run:
+// precision and recall of the curve map at 2 cm. curvesfm runs as a subprocess (--curvesfm, default
+// the one built beside this bench); a variant whose flags the executable does not list in its
+// --help is skipped with a note, so the table can name flags that a later curvesfm adds. Every
+// trajectory (init: every registered frame; curves and hybrid: the keyframes; COLMAP: every
+// registered image) is compared with the set's ground truth from loadImageSequence by
+// compareTrajectories (Sim(3), core/trajectory_evaluation.h).
 //
 // Writes into --out: real_bench.csv (one row per set and variant), real_bench.md (the table, also
 // printed), SET/groundtruth.txt and SET/VARIANT/aligned_trajectory.txt (the estimate carried onto
@@ -71,6 +72,9 @@ namespace curvesfm {
 namespace {
 
 namespace fs = std::filesystem;
+
+/// --start-jitter-seed's std dev per axis, in median camera spacings: about 1e-7 m on the temples.
+constexpr double kStartJitterSpacings = 1e-6;
 
 /// One real image set of the data folder and what it needs to be read as the paper uses it.
 struct RealSet {
@@ -129,6 +133,9 @@ struct BenchOptions {
   /// Where every start file's world origin lies: "native" (the set's ground-truth frame, or
   /// COLMAP's) or "first" (moved, by a translation, to the first camera's centre).
   std::string start_origin = "native";
+  /// > 0: every start file's camera centres get a Gaussian of kStartJitterSpacings median camera
+  /// spacings per axis drawn with this seed, to measure the spread a single run hides.
+  int start_jitter_seed = 0;
   /// Diagnosis: the start ("truth" or "noiseN") whose poses lift and register every curve of
   /// the truth and noise runs (`run --diagnose-frontend-poses`), so that a map and a start of
   /// different errors meet; empty: each run lifts its map at its own start.
@@ -460,6 +467,22 @@ std::vector<StampedPose> noisyStart(const std::vector<StampedPose>& truth,
   return noisy;
 }
 
+/// --start-origin and --start-jitter-seed applied to a start's poses.
+void reframeStart(const BenchOptions& options, std::vector<StampedPose>* poses) {
+  if (poses->empty()) return;
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  if (options.start_origin == "first") shift = -poses->front().world_from_cam.translation();
+  std::mt19937 rng(static_cast<std::uint32_t>(options.start_jitter_seed));
+  std::normal_distribution<double> jitter(0.0, kStartJitterSpacings * medianSpacing(*poses));
+  for (StampedPose& pose : *poses) {
+    Eigen::Vector3d centre = pose.world_from_cam.translation() + shift;
+    if (options.start_jitter_seed > 0) {
+      for (int k = 0; k < 3; ++k) centre[k] += jitter(rng);
+    }
+    pose.world_from_cam = Pose3(pose.world_from_cam.rotation(), centre);
+  }
+}
+
 /// The TUM file of `start` for one set (written on first use), or empty for the initialiser's
 /// start; throws when COLMAP's start is asked for and COLMAP gave no poses.
 std::string startPosesFile(const Start& start, const ImageSequence& sequence,
@@ -474,13 +497,7 @@ std::string startPosesFile(const Start& start, const ImageSequence& sequence,
     if (colmap_poses.empty()) throw Error("COLMAP gave no poses to start from");
     poses = colmap_poses;
   }
-  if (options.start_origin == "first" && !poses.empty()) {
-    const Eigen::Vector3d origin = poses.front().world_from_cam.translation();
-    for (StampedPose& pose : poses) {
-      pose.world_from_cam = Pose3(pose.world_from_cam.rotation(),
-                                  Eigen::Vector3d(pose.world_from_cam.translation() - origin));
-    }
-  }
+  reframeStart(options, &poses);
   writeTrajectory(path.string(), poses);
   return path.string();
 }
@@ -1117,6 +1134,13 @@ int main(int argc, char** argv) {
                  "(moved by a translation to the first camera's centre); the refined poses must "
                  "not depend on it")
       ->check(CLI::IsMember({"native", "first"}))
+      ->capture_default_str();
+  app.add_option("--start-jitter-seed", options.start_jitter_seed,
+                 "> 0: move every start file's camera centres by a Gaussian of 1e-6 median camera "
+                 "spacings per axis drawn with this seed (far below any data's accuracy, yet it "
+                 "flips the pipeline's discrete decisions: run several seeds to see the spread a "
+                 "single run hides); 0: none")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option_function<std::string>(
          "--map-at",

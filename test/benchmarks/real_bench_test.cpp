@@ -49,6 +49,12 @@ TEST(RealBenchCommandLine, RejectsAStartOriginOtherThanNativeOrFirst) {
   EXPECT_THAT(r.output, HasSubstr("--start-origin: centre not in {native,first}"));
 }
 
+TEST(RealBenchCommandLine, RejectsANegativeStartJitterSeed) {
+  const testing::CommandResult r = runRealBench("--start-jitter-seed -1");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--start-jitter-seed"));
+}
+
 TEST(RealBenchCommandLine, RejectsAMapAtLabelThatNamesNoStart) {
   for (const char* label : {"noise", "noise1x", "colmap", "noise12345678901234567890"}) {
     const testing::CommandResult r = runRealBench(std::string("--map-at ") + label);

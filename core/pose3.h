@@ -14,9 +14,9 @@ namespace curvesfm {
 /// Tangent space (the chart used by the optimiser and all Jacobians), delta = [w; u]:
 ///   retract(delta) = (exp(w), u) * (R, t) = (exp(w) * R, exp(w) * t + u)
 /// i.e. a rigid motion of the target frame applied on the left. For `cam_from_world` the rotation
-/// turns the camera about its own centre and u shifts it in its own frame, so the chart, and with
-/// it every solver step, does not depend on where the source (world) frame's origin lies: a
-/// world frame moved rigidly gives the same steps (g2o's and Sophus' left update).
+/// turns the camera about its own centre and u shifts it in its own frame, so a tangent step
+/// moves the camera the same way whatever the source (world) frame: a start moved rigidly takes
+/// the same pose steps (g2o's and Sophus' left update).
 /// Ambient storage for solvers: 7 doubles [qx, qy, qz, qw, tx, ty, tz] (Eigen's order), qw >= 0.
 class Pose3 {
  public:

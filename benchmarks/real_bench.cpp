@@ -47,6 +47,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -472,11 +473,14 @@ void reframeStart(const BenchOptions& options, std::vector<StampedPose>* poses) 
   if (poses->empty()) return;
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();
   if (options.start_origin == "first") shift = -poses->front().world_from_cam.translation();
+  // normal_distribution needs a positive std dev: no jitter for a start that does not move.
+  const double jitter_sigma =
+      options.start_jitter_seed > 0 ? kStartJitterSpacings * medianSpacing(*poses) : 0.0;
   std::mt19937 rng(static_cast<std::uint32_t>(options.start_jitter_seed));
-  std::normal_distribution<double> jitter(0.0, kStartJitterSpacings * medianSpacing(*poses));
+  std::normal_distribution<double> jitter(0.0, jitter_sigma > 0.0 ? jitter_sigma : 1.0);
   for (StampedPose& pose : *poses) {
     Eigen::Vector3d centre = pose.world_from_cam.translation() + shift;
-    if (options.start_jitter_seed > 0) {
+    if (jitter_sigma > 0.0) {
       for (int k = 0; k < 3; ++k) centre[k] += jitter(rng);
     }
     pose.world_from_cam = Pose3(pose.world_from_cam.rotation(), centre);
@@ -1140,7 +1144,7 @@ int main(int argc, char** argv) {
                  "spacings per axis drawn with this seed (far below any data's accuracy, yet it "
                  "flips the pipeline's discrete decisions: run several seeds to see the spread a "
                  "single run hides); 0: none")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(0, std::numeric_limits<int>::max()))
       ->capture_default_str();
   app.add_option_function<std::string>(
          "--map-at",

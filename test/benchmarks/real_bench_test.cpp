@@ -52,7 +52,7 @@ TEST(RealBenchCommandLine, RejectsAStartOriginOtherThanNativeOrFirst) {
 TEST(RealBenchCommandLine, RejectsANegativeStartJitterSeed) {
   const testing::CommandResult r = runRealBench("--start-jitter-seed -1");
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_THAT(r.output, HasSubstr("--start-jitter-seed"));
+  EXPECT_THAT(r.output, HasSubstr("--start-jitter-seed: Value -1 not in range 0 to 2147483647"));
 }
 
 TEST(RealBenchCommandLine, RejectsAMapAtLabelThatNamesNoStart) {

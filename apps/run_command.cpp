@@ -372,7 +372,8 @@ nlohmann::json frameToJson(const KeyframeStats& s) {
       {"extended_curves", s.extended_curves},
       {"global_curves", s.global_curves},
       {"temporary_curves", s.temporary_curves},
-      {"local_ba_cost", {{"initial", s.local_ba_initial_cost}, {"final", s.local_ba_final_cost}}}};
+      {"local_ba_cost", {{"initial", s.local_ba_initial_cost}, {"final", s.local_ba_final_cost}}},
+      {"local_ba_iterations", s.local_ba_iterations}};
 }
 
 // Costs per factor type before the first and after the last solve of global BA.

@@ -942,6 +942,7 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
     stats.local_ba_seconds = report.total_seconds;
     stats.local_ba_initial_cost = report.initial_cost;
     stats.local_ba_final_cost = report.final_cost;
+    stats.local_ba_iterations = report.total_iterations;
   }
   stats.global_curves = map.count(CurveState::kGlobal);
   stats.temporary_curves = map.count(CurveState::kTemporary);

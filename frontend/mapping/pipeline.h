@@ -243,6 +243,7 @@ struct KeyframeStats {
   int temporary_curves = 0;
   double local_ba_initial_cost = 0.0;
   double local_ba_final_cost = 0.0;
+  int local_ba_iterations = 0;  ///< Levenberg-Marquardt iterations over its solves.
 
   int rejectedSegments() const {
     return rejected_duplicate + rejected_depth + rejected_edge_distance +

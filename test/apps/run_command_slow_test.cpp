@@ -79,6 +79,8 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
     EXPECT_TRUE(round["global_ba"].contains("rounds"));
   }
   EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));
+  // Keyframe 5's local BA refined the curves its window observes.
+  EXPECT_GT(report["frames"][5]["local_ba_iterations"].get<int>(), 0);
   EXPECT_TRUE(report["ate"]["refined_m"].contains("rmse"));
   // How far each stage moved the poses, and the curves that pull them most.
   ASSERT_TRUE(report["pose_stages"].is_array());

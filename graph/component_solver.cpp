@@ -255,6 +255,7 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
     if (solved &&
         step.norm() <= (x_norm + options.parameter_tolerance) * options.parameter_tolerance) {
       result.converged = true;
+      --result.iterations;  // As Ceres, the stopping iteration is not counted.
       break;
     }
     const double model_decrease = solved ? -(g.dot(step) + 0.5 * step.dot(H * step)) : 0.0;
@@ -264,6 +265,13 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
       new_cost = problem->evaluate(candidate, nullptr, nullptr);
     }
     const double change = cost - new_cost;
+    // As Ceres: a step changing the cost too little ends the solve, kept or not (a rough cost
+    // near its minimum would otherwise reject step after step until the radius collapses).
+    if (model_decrease > 0.0 && std::abs(change) <= options.function_tolerance * cost) {
+      result.converged = true;
+      --result.iterations;
+      break;
+    }
     if (model_decrease > 0.0 && std::isfinite(new_cost) &&
         change > kMinRelativeDecrease * model_decrease) {
       const double ratio = change / model_decrease;

@@ -221,7 +221,7 @@ struct KeyframeStats {
   double depth_seconds = 0.0;
   double correspondence_seconds = 0.0;  ///< Pose tracking, projection and the four checks.
   double initialise_seconds = 0.0;      ///< New curves from unregistered chains.
-  double local_ba_seconds = 0.0;
+  double local_ba_seconds = 0.0;        ///< Building the window's graph, solving, writing back.
   // Counts.
   int edge_pixels = 0;
   /// Canny hysteresis thresholds applied to this keyframe (grey levels / px), automatic or given.

@@ -124,5 +124,48 @@ TEST(OptimizeComponents, TheHookSeesTheStartAndTheEnd) {
   EXPECT_NEAR(seen[1].cost, summary.final_cost, 1e-9 * summary.final_cost);
 }
 
+// e = point - target, its x row shifted by +/- jump on either side of x = 0: a residual that
+// jumps, as the nearest-edge residual does between pixels, with its minimum at the jump.
+class SteppedPriorFactor : public NoiseModelFactorN<3, Eigen::Vector3d> {
+  using Base = NoiseModelFactorN<3, Eigen::Vector3d>;
+
+ public:
+  SteppedPriorFactor(Key point, double jump) : Base({point}, NoiseModel{}), jump_(jump) {}
+  Error evaluateError(const Eigen::Vector3d& point, Jacobian<Eigen::Vector3d>* H) const override {
+    if (H) H->setIdentity();
+    Error e = point;
+    e.x() += point.x() >= 0.0 ? jump_ : -jump_;
+    return e;
+  }
+  const char* typeName() const override { return "stepped_prior"; }
+
+ private:
+  double jump_;
+};
+
+TEST(OptimizeComponents, AStepThatBarelyChangesTheCostEndsTheSolveAsInTheJointSolver) {
+  // From x = 2 the first step lands at x = -0.5 and the next one jumps to +0.5 at the same
+  // cost. Ceres (and graph_schur) stop there; a solver that only rejected that step would crawl
+  // towards the jump with ever smaller steps until max_iterations.
+  FactorGraph graph;
+  graph.add(std::make_shared<SteppedPriorFactor>(pointKey(0), 0.5));
+  Values start;
+  start.insert(pointKey(0), Eigen::Vector3d(2.0, 1.0, -1.0));
+  OptimizerOptions options;
+  options.initial_trust_region_radius = 1e16;  // Gauss-Newton's steps, to know where they land.
+  options.max_iterations = 50;
+  Values apart = start, joint = start;
+  options.solve_components_apart = true;
+  const OptimizationSummary a = optimize(graph, &apart, ProblemConfig{}, options);
+  options.solve_components_apart = false;
+  options.linear_solver = LinearSolver::kGraphSchur;
+  const OptimizationSummary j = optimize(graph, &joint, ProblemConfig{}, options);
+  EXPECT_EQ(a.termination, "CONVERGENCE") << a.message;
+  EXPECT_EQ(a.iterations, j.iterations) << j.message;
+  EXPECT_LT(a.iterations, 5);
+  EXPECT_NEAR(apart.at<Eigen::Vector3d>(pointKey(0)).x(), -0.5, 1e-9);
+  EXPECT_NEAR(a.final_cost, j.final_cost, 1e-12);
+}
+
 }  // namespace
 }  // namespace curvesfm

@@ -192,6 +192,10 @@ TEST(Pipeline, DropsCurvesOutsideTheExtentAndJudgesTheRun) {
   for (int i = 0; i < 5; ++i) {
     for (int j = 0; j < 5; ++j) patch.emplace_back(-0.02 + 0.01 * i, -0.02 + 0.01 * j, 0.0);
   }
+  // A slab 1 cm thick about the plane: a curve on the plane lies inside the extent's depth
+  // whichever side of z = 0 its fit rounds to.
+  patch.emplace_back(0.0, 0.0, 0.005);
+  patch.emplace_back(0.0, 0.0, -0.005);
   pipeline.setPoints(patch);
   for (std::size_t i = 0; i < scene.images.size(); ++i) {
     pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});

@@ -19,6 +19,9 @@ TEST(PipelineOptions, ValidateNamesTheStageAndField) {
   EXPECT_THROW(options.validate(), InvalidOptions);
   EXPECT_EQ(PipelineOptions{}.local_ba.strategy, Strategy::kAlternating);
   EXPECT_EQ(PipelineOptions{}.local_ba.scope, Scope::kLocal);
+  EXPECT_EQ(PipelineOptions{}.local_ba.optimizer.initial_trust_region_radius, 10.0);
+  EXPECT_EQ(PipelineOptions{}.local_ba.optimizer.function_tolerance, 1e-4);
+  EXPECT_EQ(PipelineOptions{}.global_ba.optimizer.function_tolerance, 1e-6);
   EXPECT_FALSE(PipelineOptions{}.local_ba_refines_poses);
 }
 

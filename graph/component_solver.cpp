@@ -278,8 +278,8 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
       x->swap(candidate);
       cost = problem->evaluate(*x, &H, &g);
       radius.accept(ratio);
-      result.converged = change <= options.function_tolerance * cost ||
-                         g.lpNorm<Eigen::Infinity>() <= options.gradient_tolerance;
+      // The check above let through only steps changing the cost by more than the tolerance.
+      result.converged = g.lpNorm<Eigen::Infinity>() <= options.gradient_tolerance;
     } else {
       ++result.rejected;
       radius.reject();

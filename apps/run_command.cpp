@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -65,26 +66,83 @@ void printProgress(const KeyframeStats& s, int frames) {
   std::fflush(stdout);
 }
 
-std::vector<KeyframeStats> feedFrames(Pipeline* pipeline, const RunInput& input,
-                                      const std::vector<Pose3>& frontend_poses) {
-  std::vector<KeyframeStats> stats;
+// Loads the keyframes' images and runs their image stage (Pipeline::prepareImage), with
+// `ahead` one keyframe ahead on a second thread: keyframe k + 1's image stage then runs while
+// keyframe k's correspondence and local BA do, since it depends on the image alone. Only the
+// keyframes' images are read (selectKeyframes).
+class KeyframeImageFeed {
+ public:
+  KeyframeImageFeed(const Pipeline& pipeline, const RunInput& input, std::vector<bool> keyframes,
+                    bool ahead)
+      : pipeline_(pipeline), input_(input), keyframes_(std::move(keyframes)), ahead_(ahead) {
+    if (ahead_) startAfter(-1);
+  }
+
+  /// The image stage of frame i, which must be the next keyframe.
+  std::shared_ptr<const KeyframeImage> take(int i) {
+    if (!ahead_) return prepare(i);
+    const Clock::time_point start = Clock::now();
+    CURVESFM_CHECK(next_frame_ == i) << "frame " << i << " taken out of order";
+    std::shared_ptr<const KeyframeImage> image = next_.get();  // Rethrows a failed load.
+    wait_seconds_ += secondsSince(start);
+    startAfter(i);
+    return image;
+  }
+  /// Time spent waiting for a keyframe's image stage run ahead (s).
+  double waitSeconds() const { return wait_seconds_; }
+
+ private:
+  std::shared_ptr<const KeyframeImage> prepare(int i) const {
+    const cv::Mat image = loadFrameImage(input_.frames[i], input_.sequence.camera);
+    return std::make_shared<const KeyframeImage>(pipeline_.prepareImage(image));
+  }
+  void startAfter(int i) {
+    next_frame_ = i + 1;
+    while (next_frame_ < static_cast<int>(keyframes_.size()) && !keyframes_[next_frame_]) {
+      ++next_frame_;
+    }
+    if (next_frame_ == static_cast<int>(keyframes_.size())) return;
+    next_ = std::async(std::launch::async, [this, frame = next_frame_] { return prepare(frame); });
+  }
+
+  const Pipeline& pipeline_;
+  const RunInput& input_;
+  const std::vector<bool> keyframes_;
+  const bool ahead_;
+  int next_frame_ = -1;
+  std::future<std::shared_ptr<const KeyframeImage>> next_;
+  double wait_seconds_ = 0.0;
+};
+
+std::vector<Pose3> initialPoses(const RunInput& input) {
+  std::vector<Pose3> poses;
+  for (const DatasetFrame& frame : input.frames) poses.push_back(frame.initial_cam_from_world);
+  return poses;
+}
+
+// Feeds every frame with an initial pose to the pipeline; returns the time spent waiting for
+// the image stage of keyframes prepared ahead (s).
+double feedFrames(Pipeline* pipeline, const RunInput& input,
+                  const std::vector<Pose3>& frontend_poses, const PipelineOptions& options,
+                  bool images_ahead) {
   const int n = static_cast<int>(input.frames.size());
   if (input.initialisation) {
     std::vector<Eigen::Vector3d> points;
     for (const InitialisedPoint& p : input.initialisation->points) points.push_back(p.position);
     pipeline->setPoints(std::move(points));
   }
-  for (std::size_t i = 0; i < input.frames.size(); ++i) {
+  const std::vector<bool> keyframes = selectKeyframes(initialPoses(input), options);
+  KeyframeImageFeed images(*pipeline, input, keyframes, images_ahead);
+  for (int i = 0; i < n; ++i) {
     const DatasetFrame& frame = input.frames[i];
     const KeyframeStats s = pipeline->addFrame(
-        {frame.timestamp, loadFrameImage(frame, input.sequence.camera),
-         frame.initial_cam_from_world,
+        {frame.timestamp, cv::Mat(), frame.initial_cam_from_world,
          input.sightings.empty() ? std::vector<PointSighting>{} : input.sightings[i],
-         frontend_poses.empty() ? std::optional<Pose3>() : frontend_poses[i]});
+         frontend_poses.empty() ? std::optional<Pose3>() : frontend_poses[i],
+         keyframes[i] ? images.take(i) : nullptr});
     if (s.keyframe_index >= 0) printProgress(s, n);
-    stats.push_back(s);
   }
-  return stats;
+  return images.waitSeconds();
 }
 
 // Per frame of `input`, the pose a relift pass lifts its map at: the keyframe's refined pose in
@@ -485,10 +543,13 @@ CurveGrowth curveGrowth(const std::vector<KeyframeStats>& frames) {
   return growth;
 }
 
-void printSummary(const RunInput& input, const PipelineResult& r, double seconds) {
-  double frontend = 0.0, local_ba = 0.0;
+// image_wait_seconds: the time spent waiting for images prepared ahead, < 0 if none were.
+void printSummary(const RunInput& input, const PipelineResult& r, double seconds,
+                  double image_wait_seconds) {
+  double frontend = 0.0, image_stage = 0.0, local_ba = 0.0;
   for (const KeyframeStats& s : r.frames) {
     frontend += s.frontendSeconds();
+    image_stage += s.undistort_seconds + s.edges_seconds + s.field_seconds;
     local_ba += s.local_ba_seconds;
   }
   const CurveGrowth growth = curveGrowth(r.frames);
@@ -526,6 +587,12 @@ void printSummary(const RunInput& input, const PipelineResult& r, double seconds
       "time: frontend %.2f s, local BA %.2f s, global BA %.2f s, total %.2f s; peak memory %.0f "
       "MiB\n",
       frontend, local_ba, r.globalBaSeconds(), seconds, peakResidentMiB());
+  if (image_wait_seconds >= 0.0) {
+    std::printf(
+        "images ahead: the image stage (%.2f s of the frontend) ran on a second thread while "
+        "local BA did; %.2f s waited for it\n",
+        image_stage, image_wait_seconds);
+  }
   printFrontendStages(r.frames);
 }
 
@@ -684,6 +751,10 @@ RunCommand::RunCommand(CLI::App* app) {
                 "With given initial poses, triangulate the initialiser's tracks at them (points "
                 "for the depth ranges and --ba-points)")
       ->capture_default_str();
+  c->add_option("--images-ahead", images_ahead_,
+                "Load and prepare the next keyframe's image (undistortion, edges, field) on a "
+                "second thread while this one's local BA runs; the results are the same")
+      ->capture_default_str();
   c->add_option("--diagnose-frontend-poses", frontend_poses_path_,
                 "Diagnosis: lift and register curves at these poses (TUM or COLMAP model, in the "
                 "initial poses' frame and unit, e.g. the ground truth beside a perturbed copy of "
@@ -742,6 +813,7 @@ nlohmann::json RunCommand::runOptionsJson() const {
   options["points_at_given_poses"] = points_at_given_poses_;
   options["diagnose_frontend_poses"] = frontend_poses_path_;
   options["relift_passes"] = relift_passes_;
+  options["images_ahead"] = images_ahead_;
   return options;
 }
 
@@ -824,13 +896,14 @@ int RunCommand::run() const {
   std::unique_ptr<Pipeline> pipeline;
   PipelineResult result;
   std::vector<Pose3> frontend_poses = input.frontend_poses;
+  double image_wait_seconds = 0.0;
   for (int pass = 0; pass <= relift_passes_; ++pass) {
     if (pass > 0) {
       printReliftPass(pass, relift_passes_, evaluateAte(result, d));
       frontend_poses = reliftPoses(input, frontend_poses, result);
     }
     pipeline = std::make_unique<Pipeline>(d.camera, options);
-    feedFrames(pipeline.get(), input, frontend_poses);
+    image_wait_seconds += feedFrames(pipeline.get(), input, frontend_poses, options, images_ahead_);
     result = pipeline->finish();
   }
   const AteResult ate = evaluateAte(result, d);
@@ -907,9 +980,10 @@ int RunCommand::run() const {
        {"curve_statistics", curveStatisticsJson(result.curve_statistics)},
        {"sanity", sanityToJson(result.sanity)},
        {"total_seconds", seconds},
+       {"image_wait_seconds", image_wait_seconds},
        {"peak_memory_mib", peakResidentMiB()}});
 
-  printSummary(input, result, seconds);
+  printSummary(input, result, seconds, images_ahead_ ? image_wait_seconds : -1.0);
   printAte(ate, d.ground_truth_source);
   printStageMotions(motions);
   printCurveStatistics(result.curve_statistics);

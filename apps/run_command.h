@@ -67,6 +67,8 @@ class RunCommand {
   /// initial poses (as --diagnose-frontend-poses does): a map lifted at noisy poses carries
   /// their errors, one lifted at better poses carries less. >= 0.
   int relift_passes_ = 0;
+  /// Prepare the next keyframe's image stage on a second thread while this one's BA runs.
+  bool images_ahead_ = true;
   ImageSequenceOptions sequence_;
   PointInitialiserOptions initialiser_;
   PipelineOptions options_;

@@ -162,6 +162,39 @@ PolyBezier scaledCurve(const PolyBezier& curve, double factor) {
   return PolyBezier(std::move(points), curve.directions(), std::move(lengths));
 }
 
+// The keyframe choice of addFrame, shared with selectKeyframes: the scene scale (given, or learnt
+// from the first frame whose initial centre left frame 0's) and the selector on the initial
+// poses in that unit.
+class KeyframeGate {
+ public:
+  explicit KeyframeGate(const PipelineOptions& options)
+      : selector_(options.map), scene_scale_(options.scene_scale) {}
+
+  bool admit(const Pose3& initial_cam_from_world) {
+    learnSceneScale(initial_cam_from_world.inverseTranslation());
+    return selector_.isKeyframe(initial_cam_from_world, unit());
+  }
+  /// Pose units; 0 until known.
+  double sceneScale() const { return scene_scale_; }
+  /// The unit the pipeline works in: the scene scale, or the poses' own unit while it is unknown.
+  double unit() const { return scene_scale_ > 0.0 ? scene_scale_ : 1.0; }
+
+ private:
+  void learnSceneScale(const Eigen::Vector3d& centre) {
+    if (scene_scale_ > 0.0) return;
+    if (!first_centre_) {
+      first_centre_ = centre;
+      return;
+    }
+    const double distance = (centre - *first_centre_).norm();
+    if (distance > 0.0 && std::isfinite(distance)) scene_scale_ = distance;
+  }
+
+  KeyframeSelector selector_;
+  double scene_scale_;
+  std::optional<Eigen::Vector3d> first_centre_;  // Initial centre of frame 0.
+};
+
 void countRejection(CorrespondenceCheck failed, KeyframeStats* stats) {
   switch (failed) {
     case CorrespondenceCheck::kDepth:
@@ -292,17 +325,18 @@ struct Pipeline::Impl {
         undistorter(source_camera, options.undistort),
         camera(std::make_shared<const Camera>(undistorter.camera())),
         initialiser(options.initialiser),
-        selector(options.map),
-        map(options.map),
-        scene_scale(options.scene_scale) {}
+        gate(options),
+        map(options.map) {}
 
-  // The unit the pipeline works in: the scene scale, or the poses' own unit while it is unknown.
-  double unit() const { return scene_scale > 0.0 ? scene_scale : 1.0; }
-  void updateSceneScale(const Pose3& initial_cam_from_world);
+  double unit() const { return gate.unit(); }
+  void moveKeyframesToSceneScale();
 
   KeyframeStats addFrame(const PipelineFrame& frame);
-  cv::Mat prepareKeyframe(const PipelineFrame& frame, std::vector<EdgeChain>* chains,
-                          KeyframeStats* stats);
+  KeyframeImage prepareImage(const cv::Mat& image_bgr) const {
+    return prepareKeyframeImage(image_bgr, undistorter, options.edges, options.chains,
+                                options.field);
+  }
+  void addKeyframe(const PipelineFrame& frame, const KeyframeImage& image, KeyframeStats* stats);
   void trackPose(Keyframe* keyframe);
   /// One attempt to register segment i of curve `id` in keyframe k (see tryRegister).
   struct SegmentAttempt {
@@ -356,14 +390,12 @@ struct Pipeline::Impl {
   ImageUndistorter undistorter;
   std::shared_ptr<const Camera> camera;
   CurveInitialiser initialiser;
-  KeyframeSelector selector;
+  KeyframeGate gate;
   CurveMap map;
   std::vector<Keyframe> keyframes;
   std::vector<KeyframeStats> frames;
   bool finished = false;
-  double scene_scale = 0.0;             // Pose units; 0 until known.
   std::vector<Eigen::Vector3d> points;  // The hybrid graph's, world frame, pose units.
-  Eigen::Vector3d first_centre = Eigen::Vector3d::Zero();  // Initial centre of frame 0.
   // The sanity checks (checkCurves): what they found, the last extent (scene scale) and the
   // global BAs run so far.
   std::vector<ImplausibleCurve> implausible;
@@ -371,59 +403,44 @@ struct Pipeline::Impl {
   int global_bas = 0;
 };
 
-// Derives the scene scale from the first frame that moved away from frame 0 (see
-// PipelineOptions::scene_scale). The keyframes before it all sit at frame 0's centre, kept in
-// pose units; they move to the new unit, and no curve exists yet (no baseline, no depth).
-void Pipeline::Impl::updateSceneScale(const Pose3& initial_cam_from_world) {
-  if (scene_scale > 0.0) return;
-  const Eigen::Vector3d centre = initial_cam_from_world.inverseTranslation();
-  if (frames.empty()) {
-    first_centre = centre;
-    return;
-  }
-  const double distance = (centre - first_centre).norm();
-  if (!(distance > 0.0) || !std::isfinite(distance)) return;
+// Once the gate knows the scene scale (see PipelineOptions::scene_scale): the keyframes before
+// it all sit at frame 0's centre, kept in pose units; they move to the new unit, and no curve
+// exists yet (no baseline, no depth).
+void Pipeline::Impl::moveKeyframesToSceneScale() {
   CURVESFM_CHECK(map.size() == 0) << "curves exist before the scene scale is known";
-  scene_scale = distance;
   for (Keyframe& keyframe : keyframes) {
-    keyframe.initial_cam_from_world = toSceneScale(keyframe.given_cam_from_world, distance);
+    keyframe.initial_cam_from_world = toSceneScale(keyframe.given_cam_from_world, unit());
     keyframe.cam_from_world = toSceneScale(
-        keyframe.given_frontend_cam_from_world.value_or(keyframe.given_cam_from_world), distance);
+        keyframe.given_frontend_cam_from_world.value_or(keyframe.given_cam_from_world), unit());
   }
 }
 
-cv::Mat Pipeline::Impl::prepareKeyframe(const PipelineFrame& frame, std::vector<EdgeChain>* chains,
-                                        KeyframeStats* stats) {
-  CURVESFM_CHECK(frame.image_bgr.type() == CV_8UC3)
-      << "frame " << stats->frame_index << ": expected a CV_8UC3 BGR image, found type "
-      << frame.image_bgr.type() << " (" << frame.image_bgr.channels() << " channels)";
+// Keyframe k's data from the frame and its image stage; the frame's poses in the scene scale.
+void Pipeline::Impl::addKeyframe(const PipelineFrame& frame, const KeyframeImage& image,
+                                 KeyframeStats* stats) {
   Keyframe keyframe;
   keyframe.frame_index = stats->frame_index;
   keyframe.timestamp = frame.timestamp;
-  keyframe.initial_cam_from_world = frame.initial_cam_from_world;
-  keyframe.cam_from_world = frame.initial_cam_from_world;
+  keyframe.given_cam_from_world = frame.initial_cam_from_world;
+  keyframe.initial_cam_from_world = toSceneScale(frame.initial_cam_from_world, unit());
+  keyframe.cam_from_world = keyframe.initial_cam_from_world;
+  if (frame.frontend_cam_from_world) {
+    keyframe.given_frontend_cam_from_world = frame.frontend_cam_from_world;
+    keyframe.cam_from_world = toSceneScale(*frame.frontend_cam_from_world, unit());
+  }
   keyframe.points = frame.points;
-
-  Clock::time_point start = Clock::now();
-  keyframe.image_bgr = undistorter.undistort(frame.image_bgr).clone();
-  cv::cvtColor(keyframe.image_bgr, keyframe.grey, cv::COLOR_BGR2GRAY);
-  stats->undistort_seconds = secondsSince(start);
-
-  start = Clock::now();
-  const EdgeImage edges = detectEdges(keyframe.grey, options.edges, undistorter.validMask());
-  *chains = extractEdgeChains(edges, options.chains);
-  stats->edges_seconds = secondsSince(start);
-  stats->edge_pixels = cv::countNonZero(edges.edges);
-  stats->canny_high_threshold = edges.high_threshold;
-  stats->canny_low_threshold = edges.low_threshold;
-  stats->chains = static_cast<int>(chains->size());
-
-  start = Clock::now();
-  keyframe.field = std::make_shared<const NearestEdgeField>(
-      NearestEdgeField::build(edges.edges, edges.grad_x, edges.grad_y, options.field));
-  stats->field_seconds = secondsSince(start);
+  keyframe.image_bgr = image.image_bgr;
+  keyframe.grey = image.grey;
+  keyframe.field = image.field;
   keyframes.push_back(std::move(keyframe));
-  return edges.edges;
+
+  stats->undistort_seconds = image.undistort_seconds;
+  stats->edges_seconds = image.edges_seconds;
+  stats->field_seconds = image.field_seconds;
+  stats->edge_pixels = cv::countNonZero(image.edges);
+  stats->canny_high_threshold = image.canny_high_threshold;
+  stats->canny_low_threshold = image.canny_low_threshold;
+  stats->chains = static_cast<int>(image.chains.size());
 }
 
 void Pipeline::Impl::trackPose(Keyframe* keyframe) {
@@ -671,7 +688,7 @@ std::vector<int> Pipeline::Impl::depthReferences(int k,
 
 void Pipeline::Impl::initialiseCurves(int k, const std::vector<EdgeChain>& chains,
                                       KeyframeStats* stats) {
-  if (k == 0 || chains.empty() || scene_scale <= 0.0) return;
+  if (k == 0 || chains.empty() || gate.sceneScale() <= 0.0) return;
   Clock::time_point start = Clock::now();
   const std::vector<int> reference_keyframes = depthReferences(k, chains);
   std::vector<DepthReferenceView> references;
@@ -911,23 +928,23 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   KeyframeStats stats;
   stats.frame_index = static_cast<int>(frames.size());
   stats.timestamp = frame.timestamp;
-  updateSceneScale(frame.initial_cam_from_world);
-  if (!selector.isKeyframe(frame.initial_cam_from_world, unit())) {
+  const double known_scale = gate.sceneScale();
+  const bool is_keyframe = gate.admit(frame.initial_cam_from_world);
+  if (gate.sceneScale() != known_scale) moveKeyframesToSceneScale();
+  if (!is_keyframe) {
     frames.push_back(stats);
     return stats;
   }
   const int k = static_cast<int>(keyframes.size());
   stats.keyframe_index = k;
-  std::vector<EdgeChain> chains;
+  CURVESFM_CHECK(frame.image || !frame.image_bgr.empty())
+      << "frame " << stats.frame_index << " is a keyframe but came without its image";
+  std::shared_ptr<const KeyframeImage> image = frame.image;
+  if (!image) image = std::make_shared<const KeyframeImage>(prepareImage(frame.image_bgr));
   // From here on every length is in the scene scale.
-  PipelineFrame scaled = frame;
-  scaled.initial_cam_from_world = toSceneScale(frame.initial_cam_from_world, unit());
-  const cv::Mat edges = prepareKeyframe(scaled, &chains, &stats);
-  keyframes.back().given_cam_from_world = frame.initial_cam_from_world;
-  if (frame.frontend_cam_from_world) {
-    keyframes.back().given_frontend_cam_from_world = frame.frontend_cam_from_world;
-    keyframes.back().cam_from_world = toSceneScale(*frame.frontend_cam_from_world, unit());
-  }
+  addKeyframe(frame, *image, &stats);
+  const std::vector<EdgeChain>& chains = image->chains;
+  const cv::Mat& edges = image->edges;
 
   const Clock::time_point start = Clock::now();
   if (options.track_keyframe_pose && k > 0) trackPose(&keyframes[k]);
@@ -956,6 +973,15 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   stats.temporary_curves = map.count(CurveState::kTemporary);
   frames.push_back(stats);
   return stats;
+}
+
+std::vector<bool> selectKeyframes(const std::vector<Pose3>& initial_cam_from_world,
+                                  const PipelineOptions& options) {
+  KeyframeGate gate(options);
+  std::vector<bool> keyframes;
+  keyframes.reserve(initial_cam_from_world.size());
+  for (const Pose3& pose : initial_cam_from_world) keyframes.push_back(gate.admit(pose));
+  return keyframes;
 }
 
 KeyframeTimes keyframeTimes(const std::vector<KeyframeStats>& frames) {
@@ -993,6 +1019,10 @@ Pipeline::Pipeline(const Camera& camera, const PipelineOptions& options)
 Pipeline::~Pipeline() = default;
 
 KeyframeStats Pipeline::addFrame(const PipelineFrame& frame) { return impl_->addFrame(frame); }
+
+KeyframeImage Pipeline::prepareImage(const cv::Mat& image_bgr) const {
+  return impl_->prepareImage(image_bgr);
+}
 
 PipelineResult Pipeline::finish() {
   Impl& impl = *impl_;
@@ -1037,7 +1067,7 @@ PipelineResult Pipeline::finish() {
   if (!checked_since_ba) impl.checkCurves(drop);
   // Back from the scene scale to the unit of the poses given.
   const double unit = impl.unit();
-  result.scene_scale = impl.scene_scale;
+  result.scene_scale = impl.gate.sceneScale();
   for (const Keyframe& keyframe : impl.keyframes) {
     result.keyframe_timestamps.push_back(keyframe.timestamp);
     result.keyframe_initial_cam_from_world.push_back(keyframe.given_cam_from_world);

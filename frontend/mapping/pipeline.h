@@ -19,6 +19,7 @@
 #include "frontend/image/edge_detector.h"
 #include "frontend/image/epipolar_depth.h"
 #include "frontend/image/image_undistorter.h"
+#include "frontend/image/keyframe_image.h"
 #include "frontend/mapping/curve_map.h"
 #include "frontend/mapping/sanity_checks.h"
 #include "graph/scheduler.h"
@@ -197,7 +198,9 @@ struct PointSighting {
 
 struct PipelineFrame {
   double timestamp = 0.0;
-  cv::Mat image_bgr;             ///< Colour image as loaded (distorted), CV_8UC3.
+  /// Colour image as loaded (distorted), CV_8UC3. May stay empty when `image` is given, or on a
+  /// frame that selectKeyframes says is no keyframe.
+  cv::Mat image_bgr;
   Pose3 initial_cam_from_world;  ///< Starting guess.
   /// The points of setPoints() this frame sees; used when it becomes a keyframe and
   /// ba.points is on.
@@ -207,6 +210,9 @@ struct PipelineFrame {
   /// initial_cam_from_world. With the truth here and a perturbed start, a run separates a map
   /// built at the start's errors from an optimiser that cannot leave them.
   std::optional<Pose3> frontend_cam_from_world = std::nullopt;
+  /// The image stage of image_bgr (Pipeline::prepareImage), when the caller ran it ahead, e.g.
+  /// on another thread while the previous keyframe's BA ran; else addFrame runs it.
+  std::shared_ptr<const KeyframeImage> image = nullptr;
 };
 
 /// What happened to one frame (a progress line and a report.json entry).
@@ -254,6 +260,13 @@ struct KeyframeStats {
            correspondence_seconds + initialise_seconds;
   }
 };
+
+/// Which frames Pipeline::addFrame will make keyframes, given every frame's initial pose in
+/// order: the choice depends on these poses and the options alone (the scene scale and the
+/// keyframe thresholds), so a caller can load and prepare only the keyframes' images, and ahead.
+/// Throws InvalidOptions on bad options.
+std::vector<bool> selectKeyframes(const std::vector<Pose3>& initial_cam_from_world,
+                                  const PipelineOptions& options);
 
 /// Per-stage time of the keyframes of a run: means per keyframe (ms), and the slowest
 /// keyframe's frontend time (the frontend budget is per keyframe; local BA is reported apart).
@@ -352,8 +365,13 @@ class Pipeline {
   Pipeline& operator=(const Pipeline&) = delete;
 
   /// Processes one frame: decides whether it becomes a keyframe and, if so, runs the frontend
-  /// stages and local BA. Returns the frame's stats.
+  /// stages and local BA. Returns the frame's stats. A keyframe needs its image or its image
+  /// stage (CheckError otherwise).
   KeyframeStats addFrame(const PipelineFrame& frame);
+
+  /// The image stage of a frame with this pipeline's camera and options (prepareKeyframeImage).
+  /// Reads nothing that addFrame or finish write: safe to call on another thread meanwhile.
+  KeyframeImage prepareImage(const cv::Mat& image_bgr) const;
 
   /// The point map of the hybrid graph (world frame, the unit of the initial poses), e.g. the
   /// point initialiser's; frames name what they see in PipelineFrame::points. With

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <future>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -134,6 +136,44 @@ PipelineResult runFiveFramesWithoutGlobalBa(PipelineOptions options) {
     pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
   }
   return pipeline.finish();
+}
+
+// The same run with each keyframe's image stage prepared one frame ahead on another thread (as
+// `curvesfm run --images-ahead` does) gives the same result, bit for bit: the stage depends on
+// the image alone.
+TEST(Pipeline, ImagesPreparedAheadOnAnotherThreadGiveTheSameRun) {
+  const PlanarScene scene = fiveFrameOrbit();
+  PipelineOptions options;
+  options.map.min_keyframe_translation = 0.0;
+  options.map.min_keyframe_rotation_deg = 0.0;
+  options.run_global_ba = false;
+  const PipelineResult inline_run = runFiveFramesWithoutGlobalBa(options);
+
+  Pipeline pipeline(*scene.camera, options);
+  const auto prepare = [&](std::size_t i) {
+    return std::async(std::launch::async, [&pipeline, &scene, i] {
+      return std::make_shared<const KeyframeImage>(pipeline.prepareImage(scene.images[i]));
+    });
+  };
+  std::future<std::shared_ptr<const KeyframeImage>> next = prepare(0);
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    std::shared_ptr<const KeyframeImage> image = next.get();
+    if (i + 1 < scene.images.size()) next = prepare(i + 1);
+    pipeline.addFrame(
+        {scene.timestamps[i], cv::Mat(), scene.initial_cam_from_world[i], {}, {}, image});
+  }
+  const PipelineResult ahead_run = pipeline.finish();
+
+  ASSERT_EQ(ahead_run.curves.size(), inline_run.curves.size());
+  EXPECT_GT(inline_run.curves.size(), 5u);
+  for (std::size_t c = 0; c < inline_run.curves.size(); ++c) {
+    EXPECT_EQ(ahead_run.curves[c].sample(4), inline_run.curves[c].sample(4)) << "curve " << c;
+  }
+  for (std::size_t k = 0; k < inline_run.keyframe_cam_from_world.size(); ++k) {
+    EXPECT_EQ(ahead_run.keyframe_cam_from_world[k].translation(),
+              inline_run.keyframe_cam_from_world[k].translation())
+        << "keyframe " << k;
+  }
 }
 
 // The largest camera-centre distance between the keyframe poses of that run and the starting

@@ -3,6 +3,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "core/angles.h"
 #include "core/errors.h"
 
 namespace curvesfm {
@@ -56,6 +60,43 @@ TEST(PipelineOptions, ValidateChecksTheReassociationGates) {
                     testing::HasSubstr("PipelineOptions.reassociation_occluder_depth_ratio")));
   }
   EXPECT_FALSE(PipelineOptions{}.reassociation_skip_explained);
+}
+
+// Camera centres along x (pose units) and turns about y (deg): frame 1 has not moved yet, so the
+// scene scale is frame 2's distance, 0.1; the default keyframe thresholds are 0.74 scene scales
+// and 2 deg.
+std::vector<Pose3> keyframeTestPoses() {
+  const double x[] = {0.0, 0.0, 0.1, 0.15, 0.18, 0.18, 0.18};
+  const double turn_deg[] = {0.0, 0.0, 0.0, 0.0, 0.0, 3.0, 3.0};
+  std::vector<Pose3> poses;
+  for (int i = 0; i < 7; ++i) {
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(turn_deg[i] * kDegToRad, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    poses.emplace_back(rotation, -rotation * Eigen::Vector3d(x[i], 0.0, 0.0));
+  }
+  return poses;
+}
+
+TEST(SelectKeyframes, LearnsTheSceneScaleAndChoosesAsTheRunDoes) {
+  const std::vector<Pose3> poses = keyframeTestPoses();
+  const PipelineOptions options;
+  const std::vector<bool> keyframes = selectKeyframes(poses, options);
+  EXPECT_THAT(keyframes, testing::ElementsAre(true, false, true, false, true, true, false));
+  // The run itself, given images only where selectKeyframes said: blank ones, no edges, no map.
+  Pipeline pipeline(Camera(CameraIntrinsics{}), options);
+  const cv::Mat blank(480, 640, CV_8UC3, cv::Scalar(128, 128, 128));
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const KeyframeStats stats =
+        pipeline.addFrame({static_cast<double>(i), keyframes[i] ? blank : cv::Mat(), poses[i]});
+    EXPECT_EQ(stats.keyframe_index >= 0, keyframes[i]) << "frame " << i;
+  }
+}
+
+TEST(Pipeline, AKeyframeWithoutItsImageIsAnError) {
+  Pipeline pipeline(Camera(CameraIntrinsics{}), PipelineOptions{});
+  const auto first_frame_without_image = [&] { pipeline.addFrame({0.0, cv::Mat(), Pose3()}); };
+  EXPECT_THAT(first_frame_without_image, testing::ThrowsMessage<CheckError>(testing::HasSubstr(
+                                             "frame 0 is a keyframe but came without its image")));
 }
 
 }  // namespace

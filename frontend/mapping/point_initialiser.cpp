@@ -22,12 +22,14 @@ namespace curvesfm {
 
 OptimizerOptions PointInitialiserOptions::defaultLocalSolver() {
   OptimizerOptions o;
+  o.linear_solver = LinearSolver::kGraphSchur;
   o.max_iterations = 10;
   return o;
 }
 
 OptimizerOptions PointInitialiserOptions::defaultGlobalSolver() {
   OptimizerOptions o;
+  o.linear_solver = LinearSolver::kGraphSchur;
   o.max_iterations = 30;
   return o;
 }

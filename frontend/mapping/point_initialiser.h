@@ -68,8 +68,13 @@ struct PointInitialiserOptions {
   TwoViewOptions two_view;           ///< The initial pair's geometry and acceptance.
   AbsolutePoseOptions registration;  ///< PnP registration of the next frames.
   PointBundleAdjustmentOptions ba;   ///< Objective of every BA (pixel sigma, robust kernel).
-  OptimizerOptions local_ba = defaultLocalSolver();    ///< Solver of local BA.
-  OptimizerOptions global_ba = defaultGlobalSolver();  ///< Solver of global BA.
+  /// Solvers of local and global BA: our own Schur complement (graph_schur), as the curve BAs
+  /// of `run`. Ceres' sparse_schur on two threads sums in an order the threads decide, so its
+  /// poses differ in the 13th digit from run to run, enough to flip the curve pipeline's discrete
+  /// decisions downstream; graph_schur gives the same bits for a given thread count, and the
+  /// initialiser's BAs take half the time (docs/benchmarks.md, session 29).
+  OptimizerOptions local_ba = defaultLocalSolver();
+  OptimizerOptions global_ba = defaultGlobalSolver();
   /// The initial pair's first frame is searched among this many frames (count). >= 1.
   int pair_search_frames = 20;
   /// Most frames between the initial pair's two frames (count): slow video needs a wide gap

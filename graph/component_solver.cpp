@@ -307,7 +307,7 @@ OptimizationSummary optimizeComponents(const FactorGraph& graph, Values* values,
   const auto start = Clock::now();
   OptimizationSummary summary;
   summary.num_factors = static_cast<int>(graph.size());
-  summary.initial_cost_by_type = graph.costByType(*values);
+  summary.initial_cost_by_type = graph.costByType(*values, options.num_threads);
   Setup setup = makeSetup(graph, *values, config);
   for (const VariableSlot& slot : setup.slots) {
     (slot.free ? summary.num_free_variables : summary.num_constant_variables) += 1;
@@ -341,7 +341,7 @@ OptimizationSummary optimizeComponents(const FactorGraph& graph, Values* values,
   for (const VariableSlot& slot : setup.slots) {
     if (slot.free) values->setFromAmbient(slot.key, solved_ambient.data() + slot.ambient);
   }
-  summary.final_cost_by_type = graph.costByType(*values);
+  summary.final_cost_by_type = graph.costByType(*values, options.num_threads);
   summary.writeback_seconds = secondsSince(writeback_start);
 
   int converged = 0;

@@ -1,6 +1,9 @@
 #include "graph/factor_graph.h"
 
+#include <algorithm>
+
 #include "core/check.h"
+#include "core/parallel.h"
 
 namespace curvesfm {
 
@@ -21,12 +24,29 @@ double FactorGraph::cost(const Values& values) const {
   return total;
 }
 
-std::map<std::string, FactorTypeCost> FactorGraph::costByType(const Values& values) const {
+std::map<std::string, FactorTypeCost> FactorGraph::costByType(const Values& values,
+                                                              int num_threads) const {
+  // Each factor's cost on the threads, then the sums in the factors' order: the same bits on
+  // any thread count. A solver calls this before and after every solve, so on one thread it
+  // was a tenth of a local BA.
+  const int n = static_cast<int>(factors_.size());
+  std::vector<double> costs(n);
+  const int threads = std::clamp(n / kMinFactorsPerThread, 1, std::max(1, num_threads));
+  runInParallel(threads, [&](int t) {
+    for (int i = n * t / threads; i < n * (t + 1) / threads; ++i) {
+      costs[i] = factors_[i]->cost(values);
+    }
+  });
   std::map<std::string, FactorTypeCost> by_type;
-  for (const auto& factor : factors_) {
-    FactorTypeCost& entry = by_type[factor->typeName()];
-    ++entry.count;
-    entry.cost += factor->cost(values);
+  const char* type = nullptr;
+  FactorTypeCost* entry = nullptr;
+  for (int i = 0; i < n; ++i) {
+    if (factors_[i]->typeName() != type) {  // Factors of one type mostly come in runs.
+      type = factors_[i]->typeName();
+      entry = &by_type[type];
+    }
+    ++entry->count;
+    entry->cost += costs[i];
   }
   return by_type;
 }

@@ -23,6 +23,9 @@ double totalCost(const std::map<std::string, FactorTypeCost>& by_type);
 /// cheap to copy and a solver may hold them while the graph changes.
 class FactorGraph {
  public:
+  /// Below this many factors a thread of costByType costs more to start than it saves.
+  static constexpr int kMinFactorsPerThread = 256;
+
   using FactorPtr = std::shared_ptr<const Factor>;
 
   void add(FactorPtr factor);
@@ -39,8 +42,9 @@ class FactorGraph {
 
   /// Total cost 0.5 * sum rho(|r_i / sigma_i|^2) at `values`.
   double cost(const Values& values) const;
-  /// Cost per factor typeName() at `values`.
-  std::map<std::string, FactorTypeCost> costByType(const Values& values) const;
+  /// Cost per factor typeName() at `values`, the factors evaluated on up to `num_threads`
+  /// threads (the result does not depend on their number).
+  std::map<std::string, FactorTypeCost> costByType(const Values& values, int num_threads = 1) const;
 
  private:
   std::vector<FactorPtr> factors_;

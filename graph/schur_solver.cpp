@@ -725,7 +725,7 @@ std::optional<OptimizationSummary> optimizeWithGraphSchur(const FactorGraph& gra
   }
   OptimizationSummary summary;
   summary.num_factors = static_cast<int>(graph.size());
-  summary.initial_cost_by_type = graph.costByType(*values);
+  summary.initial_cost_by_type = graph.costByType(*values, options.num_threads);
   summary.num_free_variables = problem.numFreeSlots();
   summary.num_constant_variables = problem.numConstantSlots();
   summary.num_effective_parameters = problem.numEffectiveParameters();
@@ -742,7 +742,7 @@ std::optional<OptimizationSummary> optimizeWithGraphSchur(const FactorGraph& gra
 
   const auto writeback_start = Clock::now();
   problem.writeBack(x, values);
-  summary.final_cost_by_type = graph.costByType(*values);
+  summary.final_cost_by_type = graph.costByType(*values, options.num_threads);
   summary.writeback_seconds = secondsSince(writeback_start);
   summary.initial_cost = totalCost(summary.initial_cost_by_type);
   summary.final_cost = totalCost(summary.final_cost_by_type);

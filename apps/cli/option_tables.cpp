@@ -141,7 +141,9 @@ void addDepth(OptionsTable* table, EpipolarDepthOptions* d, const std::string& p
       .number("min_window_support", "min-window-support", &d->min_window_support,
               "Least consistent depths in a pixel's window")
       .number("outlier_sigmas", "outlier-sigmas", &d->outlier_sigmas,
-              "Outlier distance from the window median (std devs)");
+              "Outlier distance from the window median (std devs)")
+      .threads("num_threads", "threads", &d->num_threads,
+               "Threads the chains are split over (the depths do not depend on it)");
 }
 
 void addCurveStages(OptionsTable* table, PipelineOptions* o, const std::string& path) {

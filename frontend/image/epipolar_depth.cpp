@@ -12,6 +12,7 @@
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/parallel.h"
 
 namespace curvesfm {
 namespace {
@@ -718,6 +719,7 @@ void EpipolarDepthOptions::validate() const {
           min_window_support, "in [1, 2 * smoothing_half_window + 1]");
   require(inOpenClosed(outlier_sigmas, 0.0, 100.0), "outlier_sigmas", outlier_sigmas,
           "in (0, 100]");
+  require(inClosed(num_threads, 1, 64), "num_threads", num_threads, "in [1, 64]");
 }
 
 static_assert(static_cast<int>(DepthStatus::kUnsupported) + 1 == kNumDepthStatuses,
@@ -749,6 +751,31 @@ std::vector<ReferenceCandidate> rankReferenceFrames(
   return ranked;
 }
 
+namespace {
+
+// Below this many chain pixels a thread costs more to start than its share saves (a search takes
+// about 2 us a pixel).
+constexpr std::size_t kMinPixelsPerThread = 256;
+
+// Where each of up to `threads` runs of consecutive chains starts, with about as many pixels
+// each, then chains.size().
+std::vector<std::size_t> splitByPixels(const std::vector<EdgeChain>& chains, int threads) {
+  std::size_t total = 0;
+  for (const EdgeChain& chain : chains) total += chain.pixels.size();
+  const std::size_t runs =
+      std::clamp<std::size_t>(total / kMinPixelsPerThread, 1, static_cast<std::size_t>(threads));
+  std::vector<std::size_t> first = {0};
+  std::size_t seen = 0;
+  for (std::size_t c = 0; c < chains.size() && first.size() < runs; ++c) {
+    seen += chains[c].pixels.size();
+    if (seen * runs >= total * first.size()) first.push_back(c + 1);
+  }
+  first.push_back(chains.size());
+  return first;
+}
+
+}  // namespace
+
 ChainDepths estimateChainDepths(const cv::Mat& keyframe_image, const Pose3& keyframe_cam_from_world,
                                 const std::vector<EdgeChain>& chains,
                                 const std::vector<DepthReferenceView>& references,
@@ -761,24 +788,32 @@ ChainDepths estimateChainDepths(const cv::Mat& keyframe_image, const Pose3& keyf
     geometries.push_back(referenceGeometry(static_cast<int>(r), keyframe_cam_from_world,
                                            references[r].cam_from_world, camera, options));
   }
-  DepthSearcher searcher(keyframe_image, references, std::move(geometries), camera, options);
-
+  const DepthSearcher searcher(keyframe_image, references, std::move(geometries), camera, options);
   ChainDepths result;
   result.chains.resize(chains.size());
-  std::vector<RawDepth> raw;
-  for (std::size_t c = 0; c < chains.size(); ++c) {
-    const EdgeChain& chain = chains[c];
-    const int n = static_cast<int>(chain.pixels.size());
-    raw.assign(n, RawDepth());
-    for (int i = 0; i < n; i += options.pixel_step) {
-      raw[i] = searcher.search(chain.pixels[i], chain.normals[i]);
+  const std::vector<std::size_t> first = splitByPixels(chains, options.num_threads);
+  const int threads = static_cast<int>(first.size()) - 1;
+  std::vector<DepthCounts> counts(threads);
+  runInParallel(threads, [&](int t) {
+    DepthSearcher own = searcher;  // Shares the images; its own scratch buffers.
+    std::vector<RawDepth> raw;
+    for (std::size_t c = first[t]; c < first[t + 1]; ++c) {
+      const EdgeChain& chain = chains[c];
+      const int n = static_cast<int>(chain.pixels.size());
+      raw.assign(n, RawDepth());
+      for (int i = 0; i < n; i += options.pixel_step) {
+        raw[i] = own.search(chain.pixels[i], chain.normals[i]);
+      }
+      std::vector<PixelDepth>& out = result.chains[c];
+      out.resize(n);
+      for (int i = 0; i < n; ++i) {
+        out[i] = smoothPixel(raw, i, chain.closed, options);
+        ++counts[t].by_status[static_cast<int>(out[i].status)];
+      }
     }
-    std::vector<PixelDepth>& out = result.chains[c];
-    out.resize(n);
-    for (int i = 0; i < n; ++i) {
-      out[i] = smoothPixel(raw, i, chain.closed, options);
-      ++result.counts.by_status[static_cast<int>(out[i].status)];
-    }
+  });
+  for (const DepthCounts& part : counts) {
+    for (int s = 0; s < kNumDepthStatuses; ++s) result.counts.by_status[s] += part.by_status[s];
   }
   return result;
 }

@@ -84,6 +84,9 @@ struct EpipolarDepthOptions {
   /// A depth further than this many of its standard deviations from its window's median (in
   /// inverse depth) is an outlier (unitless). In (0, 100].
   double outlier_sigmas = 3.0;
+  /// Threads the chains are split over (count; the result does not depend on it: each chain is
+  /// searched on one thread). In [1, 64].
+  int num_threads = 1;
 
   /// Throws InvalidOptions naming the first field outside its range.
   void validate() const;
@@ -223,7 +226,8 @@ std::vector<ReferenceCandidate> rankReferenceFrames(
 /// `keyframe_image` and every reference image: CV_8UC1 grey, undistorted, of the camera's size;
 /// `camera` without distortion (ImageUndistorter::camera()); each chain's normals are the unit
 /// image gradients of the keyframe at its pixels (extractEdgeChains). Chain pixels outside the
-/// image are rejected as kAtImageBorder. One thread, no allocation per pixel. The time per
+/// image are rejected as kAtImageBorder. Chains split over options.num_threads threads, no
+/// allocation per pixel. The time per
 /// searched pixel grows with its segment, about f * baseline * (1 / min_depth - 1 / max_depth)
 /// px: epipolar_depth_bench measures about 2 us per pixel for 100 px segments (pixel_step halves
 /// the total).

@@ -292,6 +292,29 @@ TEST(EpipolarDepth, PixelStepInterpolatesSkippedPixels) {
   EXPECT_LT(run.accuracy.median_relative_error, 0.005);
 }
 
+// Each chain is searched on one thread, so the chains split over threads give the same depths.
+TEST(EpipolarDepth, ThreadsGiveTheSameDepths) {
+  const ThreeViewRun one = runThreeViews(randomTexture(1000, 800, 3), planeOptions());
+  ASSERT_GT(one.accuracy.pixels, 3000);
+  for (const int threads : {2, 3, 64}) {
+    EpipolarDepthOptions options = planeOptions();
+    options.num_threads = threads;
+    const ThreeViewRun many = runThreeViews(randomTexture(1000, 800, 3), options);
+    ASSERT_EQ(many.depths.chains.size(), one.depths.chains.size());
+    EXPECT_EQ(many.depths.counts.by_status, one.depths.counts.by_status) << threads << " threads";
+    for (std::size_t c = 0; c < one.depths.chains.size(); ++c) {
+      for (std::size_t i = 0; i < one.depths.chains[c].size(); ++i) {
+        const PixelDepth& a = one.depths.chains[c][i];
+        const PixelDepth& b = many.depths.chains[c][i];
+        ASSERT_TRUE(a.status == b.status && a.depth == b.depth &&
+                    a.inverse_depth_variance == b.inverse_depth_variance &&
+                    a.reference == b.reference)
+            << "chain " << c << " pixel " << i << ", " << threads << " threads";
+      }
+    }
+  }
+}
+
 // Horizontal stripes seen without rotation from the keyframe, from 12 cm to the side (horizontal
 // epipolar lines, along the edges) and from 10 cm up (vertical ones, across the edges).
 struct StripeViews {
@@ -407,6 +430,7 @@ TEST(EpipolarDepthOptions, BadValuesThrowNamingTheField) {
   expectInvalid([](EpipolarDepthOptions* o) { o->pixel_step = 0; }, "pixel_step");
   expectInvalid([](EpipolarDepthOptions* o) { o->min_window_support = 8; }, "min_window_support");
   expectInvalid([](EpipolarDepthOptions* o) { o->outlier_sigmas = -1.0; }, "outlier_sigmas");
+  expectInvalid([](EpipolarDepthOptions* o) { o->num_threads = 0; }, "num_threads");
   // Infinity is a valid far limit.
   EpipolarDepthOptions options;
   options.max_depth = std::numeric_limits<double>::infinity();

@@ -939,6 +939,9 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   stats.keyframe_index = k;
   CURVESFM_CHECK(frame.image || !frame.image_bgr.empty())
       << "frame " << stats.frame_index << " is a keyframe but came without its image";
+  CURVESFM_CHECK(frame.image || frame.image_bgr.type() == CV_8UC3)
+      << "frame " << stats.frame_index << ": expected a CV_8UC3 BGR image, found type "
+      << frame.image_bgr.type() << " (" << frame.image_bgr.channels() << " channels)";
   std::shared_ptr<const KeyframeImage> image = frame.image;
   if (!image) image = std::make_shared<const KeyframeImage>(prepareImage(frame.image_bgr));
   // From here on every length is in the scene scale.

@@ -97,6 +97,12 @@ TEST(Pipeline, AKeyframeWithoutItsImageIsAnError) {
   const auto first_frame_without_image = [&] { pipeline.addFrame({0.0, cv::Mat(), Pose3()}); };
   EXPECT_THAT(first_frame_without_image, testing::ThrowsMessage<CheckError>(testing::HasSubstr(
                                              "frame 0 is a keyframe but came without its image")));
+  Pipeline fresh(Camera(CameraIntrinsics{}), PipelineOptions{});  // addFrame threw: start anew.
+  const auto grey_first_frame = [&] {
+    fresh.addFrame({0.0, cv::Mat(480, 640, CV_8UC1, cv::Scalar(128)), Pose3()});
+  };
+  EXPECT_THAT(grey_first_frame, testing::ThrowsMessage<CheckError>(testing::HasSubstr(
+                                    "frame 0: expected a CV_8UC3 BGR image, found type 0")));
 }
 
 }  // namespace

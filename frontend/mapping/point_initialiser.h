@@ -72,7 +72,7 @@ struct PointInitialiserOptions {
   /// of `run`. Ceres' sparse_schur on two threads sums in an order the threads decide, so its
   /// poses differ in the 13th digit from run to run, enough to flip the curve pipeline's discrete
   /// decisions downstream; graph_schur gives the same bits for a given thread count, and the
-  /// initialiser's BAs take half the time (docs/benchmarks.md, session 29).
+  /// initialiser's BAs ran 1.1-3x faster on the six real sets (docs/benchmarks.md, session 29).
   OptimizerOptions local_ba = defaultLocalSolver();
   OptimizerOptions global_ba = defaultGlobalSolver();
   /// The initial pair's first frame is searched among this many frames (count). >= 1.

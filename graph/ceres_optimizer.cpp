@@ -2,10 +2,12 @@
 #include <ceres/solver.h>
 
 #include <algorithm>
+#include <optional>
 
 #include "core/clock.h"
 #include "graph/ceres_problem.h"
 #include "graph/component_solver.h"
+#include "graph/levenberg_marquardt.h"
 #include "graph/optimizer.h"
 #include "graph/schur_solver.h"
 
@@ -17,17 +19,29 @@ bool isSchur(LinearSolver solver) {
          solver == LinearSolver::kIterativeSchur || solver == LinearSolver::kGraphSchur;
 }
 
-// Hands every iteration of a solve to OptimizerOptions::on_iteration.
+// Hands every iteration of a solve to OptimizerOptions::on_iteration, and ends a stalled one
+// (OptimizerOptions::stall_iterations).
 class IterationHook : public ceres::IterationCallback {
  public:
-  explicit IterationHook(const std::function<void(const IterationProgress&)>& hook) : hook_(hook) {}
+  explicit IterationHook(const OptimizerOptions& options)
+      : hook_(options.on_iteration),
+        window_(options.stall_iterations),
+        tolerance_(options.stall_tolerance) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    hook_({s.iteration, s.cost, s.cumulative_time_in_seconds, s.step_is_successful});
-    return ceres::SOLVER_CONTINUE;
+    if (hook_) hook_({s.iteration, s.cost, s.cumulative_time_in_seconds, s.step_is_successful});
+    if (s.iteration == 0) {
+      stall_.emplace(window_, tolerance_, s.cost);
+      return ceres::SOLVER_CONTINUE;
+    }
+    return stall_ && stall_->stalled(s.cost) ? ceres::SOLVER_TERMINATE_SUCCESSFULLY
+                                             : ceres::SOLVER_CONTINUE;
   }
 
  private:
   const std::function<void(const IterationProgress&)>& hook_;
+  int window_;
+  double tolerance_;
+  std::optional<StallTest> stall_;
 };
 
 }  // namespace
@@ -76,8 +90,10 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values, const Pro
   summary.num_free_variables = static_cast<int>(bridge.keys().size()) - bridge.numConstant();
   summary.setup_seconds = secondsSince(start);
 
-  IterationHook hook(options.on_iteration);
-  if (options.on_iteration) ceres_options.callbacks.push_back(&hook);
+  IterationHook hook(options);
+  if (options.on_iteration || options.stall_iterations > 0) {
+    ceres_options.callbacks.push_back(&hook);
+  }
   const auto solve_start = Clock::now();
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(ceres_options, &bridge.problem(), &ceres_summary);

@@ -242,6 +242,7 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
   Eigen::VectorXd g(n);
   double cost = problem->evaluate(*x, &H, &g);
   TrustRegionRadius radius(options.initial_trust_region_radius);
+  StallTest stall(options.stall_iterations, options.stall_tolerance, cost);
   std::vector<double> candidate;
   result.converged = g.lpNorm<Eigen::Infinity>() <= options.gradient_tolerance;
   while (!result.converged && result.iterations < options.max_iterations) {
@@ -285,6 +286,7 @@ ComponentResult minimise(ComponentProblem* problem, std::vector<double>* x,
       radius.reject();
       result.converged = radius.collapsed();
     }
+    result.converged = result.converged || stall.stalled(cost);
   }
   return result;
 }

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "graph/robust_kernel.h"
 
@@ -43,6 +44,27 @@ class TrustRegionRadius {
   static constexpr double kMinRadius = 1e-32;
   double radius_;
   double decrease_factor_ = 2.0;
+};
+
+/// OptimizerOptions::stall_iterations: true once the lowest cost so far fell by less than
+/// `tolerance` of itself over the last `window` iterations. window 0 never stalls.
+class StallTest {
+ public:
+  StallTest(int window, double tolerance, double start_cost)
+      : window_(window), tolerance_(tolerance), lowest_(1, start_cost) {}
+  /// After each iteration, with the cost it ended at.
+  bool stalled(double cost) {
+    if (window_ <= 0) return false;
+    lowest_.push_back(std::min(lowest_.back(), cost));
+    const std::size_t n = lowest_.size() - 1;  // Iterations so far.
+    if (n < static_cast<std::size_t>(window_)) return false;
+    return lowest_[n - window_] - lowest_[n] <= tolerance_ * std::abs(lowest_[n]);
+  }
+
+ private:
+  int window_;
+  double tolerance_;
+  std::vector<double> lowest_;  // After each iteration, the start first.
 };
 
 /// Marquardt's diagonal of H as Ceres clamps it.

@@ -15,6 +15,8 @@ void OptimizerOptions::validate() const {
   require.positive("function_tolerance", function_tolerance);
   require.positive("gradient_tolerance", gradient_tolerance);
   require.positive("parameter_tolerance", parameter_tolerance);
+  require(stall_iterations >= 0, "stall_iterations", stall_iterations, "must be >= 0");
+  require.positive("stall_tolerance", stall_tolerance);
   require(max_curve_block_size >= 1, "max_curve_block_size", max_curve_block_size, "must be >= 1");
 }
 

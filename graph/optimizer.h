@@ -82,6 +82,13 @@ struct OptimizerOptions {
   double function_tolerance = 1e-6;   ///< Stop when |dcost|/cost < this; > 0.
   double gradient_tolerance = 1e-10;  ///< Stop when max |gradient| < this; > 0.
   double parameter_tolerance = 1e-8;  ///< Stop when |dx| / (|x| + tol) < this; > 0.
+  /// Stop when the lowest cost so far fell by less than stall_tolerance of itself over the
+  /// last stall_iterations iterations, kept or rejected; 0: off, >= 0. The nearest-edge cost
+  /// is rough at the pixel scale: near its minimum Levenberg-Marquardt alternates rejected
+  /// steps with kept ones that gain a millionth, which function_tolerance (one step's change)
+  /// does not end (docs/benchmarks.md, "A budget for re-association's global BAs").
+  int stall_iterations = 0;
+  double stall_tolerance = 1e-3;  ///< See stall_iterations; > 0.
   /// Schur elimination order: structure first, poses last. Falls back to Ceres' automatic
   /// ordering (and says so in the summary) when most structure blocks share a factor with
   /// another one (a block per curve variable).

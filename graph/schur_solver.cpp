@@ -654,6 +654,7 @@ Outcome minimise(GraphSchurProblem* problem, std::vector<double>* x,
   };
   if (problem->gradientMaxNorm() <= options.gradient_tolerance) stop("Gradient tolerance reached.");
   TrustRegionRadius radius(options.initial_trust_region_radius);
+  StallTest stall(options.stall_iterations, options.stall_tolerance, cost);
   std::vector<double> candidate;
   while (!out.converged && out.iterations < options.max_iterations) {
     ++out.iterations;
@@ -697,6 +698,7 @@ Outcome minimise(GraphSchurProblem* problem, std::vector<double>* x,
     if (options.on_iteration) {  // Ceres' convention: a rejected step reports its cost too.
       options.on_iteration({out.iterations, kept ? cost : new_cost, secondsSince(start), kept});
     }
+    if (!out.converged && stall.stalled(cost)) stop("Cost stalled.");
   }
   return out;
 }

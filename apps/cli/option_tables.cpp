@@ -240,6 +240,11 @@ void addOptimizerOptions(OptionsTable* table, OptimizerOptions* o, const OptionP
               place.describe("stop when the max gradient falls below this"))
       .number("parameter_tolerance", "parameter-tolerance", &o->parameter_tolerance,
               place.describe("stop when the relative step falls below this"))
+      .number("stall_iterations", "stall-iterations", &o->stall_iterations,
+              place.describe("stop when the lowest cost fell by less than the stall tolerance "
+                             "over this many iterations (0: off)"))
+      .number("stall_tolerance", "stall-tolerance", &o->stall_tolerance,
+              place.describe("relative fall of the lowest cost over the stall iterations"))
       .boolean("structure_first_ordering", "structure-first", &o->structure_first_ordering,
                place.describe("Schur order structure first (false: Ceres chooses)"))
       .boolean("curve_blocks", "curve-blocks", &o->curve_blocks,
@@ -426,6 +431,10 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
       .number("reassociation_rounds", "reassociation-rounds", &o->reassociation_rounds,
               "After global BA: rounds of re-registering every curve in every keyframe, each "
               "followed by global BA (0: none)")
+      .number("reassociation_interim_iterations", "reassociation-interim-iterations",
+              &o->reassociation_interim_iterations,
+              "Most iterations of a global BA that a re-association round follows (0: "
+              "--global-ba-max-iterations; the last global BA always runs to it)")
       .boolean("reassociation_skip_explained", "reassociation-skip-explained",
                &o->reassociation_skip_explained,
                "Re-association leaves edges that curves observed in a keyframe already explain")

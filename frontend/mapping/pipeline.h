@@ -131,6 +131,15 @@ struct PipelineOptions {
   /// lifted over a short, noisy baseline projects too far from its edges a few keyframes on).
   /// Stops early when a round adds no observation. >= 0; 0 turns it off.
   int reassociation_rounds = 3;
+  /// Most Levenberg-Marquardt iterations of each global BA that a re-association round follows
+  /// (the first global BA and every round's but the last); the last global BA runs to
+  /// global_ba's own limits. The poses a round re-associates at need not be converged: the
+  /// next round's BA takes them on, and the later rounds then keep correcting where after
+  /// converged solves they hardly moved the poses (docs/benchmarks.md, "A budget for
+  /// re-association's global BAs": with the stall test 2.6x fewer global BA iterations on the
+  /// six real sets, 20 of 30 runs closer to the truth, 9 further). >= 0; 0: no budget, every
+  /// global BA runs to its limits.
+  int reassociation_interim_iterations = 8;
   /// Re-association leaves a keyframe's edges to the curves already observed there: a segment
   /// whose projection lies mostly (over half its samples) within explained_radius_px of the
   /// projection of a segment observed in that keyframe is not registered there, nor are two

@@ -74,7 +74,11 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_EQ(report["options"]["pipeline"]["reassociation_rounds"], 3);
   ASSERT_TRUE(report["reassociation"].is_array());
   for (const auto& round : report["reassociation"]) {
-    EXPECT_GT(round["added_observations"].get<int>(), 0);
+    // Only the last round may add nothing: it ends the rounds, and after a budgeted global BA
+    // (--reassociation-interim-iterations) its own BA still runs to convergence.
+    if (&round != &report["reassociation"].back()) {
+      EXPECT_GT(round["added_observations"].get<int>(), 0);
+    }
     EXPECT_EQ(round["left_to_other_curves"].get<int>(), 0);  // Both checks are off by default.
     EXPECT_TRUE(round["global_ba"].contains("rounds"));
   }

@@ -95,6 +95,23 @@ TEST(OptimizeComponents, MaxIterationsCountsPerComponent) {
       << summary.message;
 }
 
+// The stall test (OptimizerOptions::stall_iterations) ends each component's solve as it ends
+// the joint solvers': a loose tolerance stops every component early, as converged.
+TEST(OptimizeComponents, AStalledCostEndsEachComponent) {
+  const Scene scene = makeScene();
+  Values full = scene.start;
+  Values stalled = scene.start;
+  OptimizerOptions options = tight(true);
+  const OptimizationSummary to_the_end = optimize(scene.graph, &full, posesHeld(), options);
+  options.stall_iterations = 2;
+  options.stall_tolerance = 0.5;
+  const OptimizationSummary stopped = optimize(scene.graph, &stalled, posesHeld(), options);
+  EXPECT_EQ(stopped.termination, "CONVERGENCE") << stopped.message;
+  EXPECT_GE(stopped.iterations, 2);
+  EXPECT_LT(stopped.iterations, to_the_end.iterations);
+  EXPECT_GT(stopped.final_cost, to_the_end.final_cost);
+}
+
 TEST(OptimizeComponents, AFreePoseJoinsItsStructureIntoOneComponent) {
   const Scene scene = makeScene();
   Values values = scene.start;

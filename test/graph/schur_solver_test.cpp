@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "graph/levenberg_marquardt.h"
 #include "graph/optimizer.h"
 #include "test/graph/toy_scene.h"
 
@@ -166,6 +167,39 @@ TEST(GraphSchur, TheHookSeesEveryIteration) {
   EXPECT_EQ(seen.front().iteration, 0);
   EXPECT_NEAR(seen.front().cost, summary.initial_cost, 1e-9 * summary.initial_cost);
   EXPECT_NEAR(seen.back().cost, summary.final_cost, 1e-9 * summary.final_cost);
+}
+
+// The stall test ends a solve whose lowest cost fell by less than the tolerance over the
+// window, in both Levenberg-Marquardt implementations; the toy scene's cost falls by orders of
+// magnitude at first, so a loose tolerance ends it early and the same tolerance ends both alike.
+TEST(GraphSchur, AStalledCostEndsTheSolveAsInCeres) {
+  const Scene scene = makeScene();
+  for (const LinearSolver solver : {LinearSolver::kGraphSchur, LinearSolver::kSparseSchur}) {
+    Values full = scene.start;
+    Values stalled = scene.start;
+    OptimizerOptions options = tight(solver);
+    const OptimizationSummary to_the_end = optimize(scene.graph, &full, firstPoseHeld(), options);
+    options.stall_iterations = 2;
+    options.stall_tolerance = 0.5;
+    const OptimizationSummary stopped = optimize(scene.graph, &stalled, firstPoseHeld(), options);
+    EXPECT_GE(stopped.iterations, 2);
+    EXPECT_LT(stopped.iterations, to_the_end.iterations);
+    EXPECT_GT(stopped.final_cost, to_the_end.final_cost);
+    EXPECT_NE(stopped.message.find(solver == LinearSolver::kGraphSchur ? "stalled" : "callback"),
+              std::string::npos)
+        << stopped.message;
+  }
+}
+
+// StallTest counts the window over iterations, kept or rejected, against the lowest cost.
+TEST(StallTest, ComparesTheLowestCostAcrossTheWindow) {
+  StallTest off(0, 0.1, 100.0);
+  EXPECT_FALSE(off.stalled(100.0));
+  StallTest stall(2, 0.1, 100.0);
+  EXPECT_FALSE(stall.stalled(50.0));  // One iteration: the window is not full.
+  EXPECT_FALSE(stall.stalled(45.0));  // 100 -> 45 over two.
+  EXPECT_FALSE(stall.stalled(60.0));  // A rejected step: the lowest stays 45; 50 -> 45 is 11 %.
+  EXPECT_TRUE(stall.stalled(44.0));   // 45 -> 44 over two.
 }
 
 }  // namespace

@@ -270,6 +270,32 @@ TEST(Pipeline, DropsCurvesOutsideTheExtentAndJudgesTheRun) {
   EXPECT_GT(sanity.pose_move.spacings(), 1e-6);
 }
 
+// A budget on the global BAs that a re-association round follows: each stops at it, and the
+// last one runs to the global BA's own limits.
+TEST(Pipeline, InterimGlobalBasStopAtTheirBudgetAndTheLastRunsOn) {
+  const PlanarScene scene = fiveFrameOrbit();
+  PipelineOptions options;
+  options.reassociation_rounds = 2;
+  options.reassociation_interim_iterations = 2;
+  Pipeline pipeline(*scene.camera, options);
+  for (std::size_t i = 0; i < scene.images.size(); ++i) {
+    pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
+  }
+  const PipelineResult result = pipeline.finish();
+  ASSERT_FALSE(result.reassociation.empty());
+  std::vector<const ScheduleReport*> interim = {&result.global_ba};
+  for (std::size_t r = 0; r + 1 < result.reassociation.size(); ++r) {
+    interim.push_back(&result.reassociation[r].global_ba);
+  }
+  for (const ScheduleReport* ba : interim) {
+    EXPECT_EQ(ba->total_iterations, 2) << ba->stop_reason;
+    EXPECT_FALSE(ba->converged) << ba->stop_reason;
+  }
+  const ScheduleReport& last = result.reassociation.back().global_ba;
+  EXPECT_GT(last.total_iterations, 2);
+  EXPECT_TRUE(last.converged) << last.stop_reason;
+}
+
 // The five frames of the small orbit with global BA and one re-association round, every length
 // of the scene (true and initial poses) multiplied by `unit`: the same scene in metres
 // (unit 1) or in millimetres (unit 1000).

@@ -26,6 +26,18 @@ TEST(PipelineOptions, ValidateNamesTheStageAndField) {
   EXPECT_EQ(PipelineOptions{}.local_ba.optimizer.initial_trust_region_radius, 10.0);
   EXPECT_EQ(PipelineOptions{}.local_ba.optimizer.function_tolerance, 1e-4);
   EXPECT_EQ(PipelineOptions{}.global_ba.optimizer.function_tolerance, 1e-6);
+  EXPECT_EQ(PipelineOptions{}.global_ba.optimizer.stall_iterations, 5);
+  EXPECT_EQ(PipelineOptions{}.local_ba.optimizer.stall_iterations, 0);
+  EXPECT_EQ(PipelineOptions{}.reassociation_interim_iterations, 8);
+  options = {};
+  options.reassociation_interim_iterations = -1;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<InvalidOptions>(
+                  testing::HasSubstr("PipelineOptions.reassociation_interim_iterations")));
+  options = {};
+  options.global_ba.optimizer.stall_tolerance = 0.0;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<InvalidOptions>(testing::HasSubstr("stall_tolerance")));
   EXPECT_FALSE(PipelineOptions{}.local_ba_refines_poses);
 }
 

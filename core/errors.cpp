@@ -44,20 +44,23 @@ std::string formatOptionValue(double value) {
   return out.str();
 }
 
-void OptionCheck::operator()(bool ok, const std::string& field, double value,
-                             const std::string& constraint) const {
-  if (!ok) throw InvalidOptions(struct_name_, field, formatOptionValue(value), constraint);
+void OptionCheck::operator()(bool ok, std::string_view field, double value,
+                             std::string_view constraint) const {
+  if (!ok) {
+    throw InvalidOptions(struct_name_, std::string(field), formatOptionValue(value),
+                         std::string(constraint));
+  }
 }
 
-void OptionCheck::positive(const std::string& field, double value) const {
+void OptionCheck::positive(std::string_view field, double value) const {
   (*this)(value > 0.0 && std::isfinite(value), field, value, "must be > 0 and finite");
 }
 
-void OptionCheck::nonNegative(const std::string& field, double value) const {
+void OptionCheck::nonNegative(std::string_view field, double value) const {
   (*this)(value >= 0.0 && std::isfinite(value), field, value, "must be >= 0 and finite");
 }
 
-void OptionCheck::finite(const std::string& field, double value) const {
+void OptionCheck::finite(std::string_view field, double value) const {
   (*this)(std::isfinite(value), field, value, "must be finite");
 }
 

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 
 namespace curvesfm {
@@ -67,20 +68,22 @@ std::string formatOptionValue(double value);
 /// breaks the constraint. Write a condition as a positive comparison (value >= low) so NaN fails.
 class OptionCheck {
  public:
-  explicit OptionCheck(std::string struct_name) : struct_name_(std::move(struct_name)) {}
+  /// `struct_name` must outlive the check (a string literal): validate() runs in hot paths
+  /// (once per segment and keyframe in registration), so nothing is copied or allocated unless
+  /// a check fails.
+  explicit OptionCheck(const char* struct_name) : struct_name_(struct_name) {}
 
   /// Throws unless `ok`.
-  void operator()(bool ok, const std::string& field, double value,
-                  const std::string& constraint) const;
+  void operator()(bool ok, std::string_view field, double value, std::string_view constraint) const;
   /// > 0 and finite: "must be > 0 and finite".
-  void positive(const std::string& field, double value) const;
+  void positive(std::string_view field, double value) const;
   /// >= 0 and finite: "must be >= 0 and finite".
-  void nonNegative(const std::string& field, double value) const;
+  void nonNegative(std::string_view field, double value) const;
   /// Finite: "must be finite".
-  void finite(const std::string& field, double value) const;
+  void finite(std::string_view field, double value) const;
 
  private:
-  std::string struct_name_;
+  const char* struct_name_;
 };
 
 /// A violated internal invariant (a programmer error), thrown by CURVESFM_CHECK.

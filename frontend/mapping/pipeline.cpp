@@ -351,8 +351,9 @@ struct Pipeline::Impl {
     /// Skipped: most of it lies on already explained edges, or behind a nearer curve.
     bool explained_elsewhere = false;
     CorrespondenceVerdict verdict;
-    std::vector<cv::Point> polyline;  ///< Its projection into keyframe k.
-    std::vector<double> depths;       ///< Its vertices' depths, with the occlusion check.
+    /// Its projection into keyframe k, when it registered or a mask was checked (else empty).
+    std::vector<cv::Point> polyline;
+    std::vector<double> depths;  ///< Its vertices' depths, with the occlusion check.
   };
   SegmentAttempt tryRegister(int k, const KeyframeView& view, int id, int i,
                              const CorrespondenceOptions& checks, const cv::Mat* explained,
@@ -495,18 +496,23 @@ Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const Keyframe
   const MapCurve& curve = map.curve(id);
   const BezierSegmentParams segment = curve.curve.segment(i);
   SegmentAttempt attempt;
-  // Depths only for the occlusion check: the incremental registration tries every curve in
-  // every keyframe and has no use for them.
-  attempt.polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera,
-                                    projectionSamples(), occluders ? &attempt.depths : nullptr);
+  // Every curve is tried in every keyframe and few register: the projection is drawn only for
+  // the two masks and for a segment that registered. Depths only for the occlusion check.
+  const auto project = [&] {
+    attempt.polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera,
+                                      projectionSamples(), occluders ? &attempt.depths : nullptr);
+  };
+  if (explained || occluders) project();
   if ((explained && fractionOnMask(attempt.polyline, *explained) > 0.5) ||
       (occluders && occluders->fractionOccluded(attempt.polyline, attempt.depths) > 0.5)) {
     attempt.explained_elsewhere = true;
     return attempt;
   }
   attempt.verdict = registerSegment(segment, view, curve.segments[i].history(), checks);
-  if (attempt.verdict.registered)
+  if (attempt.verdict.registered) {
+    if (!explained && !occluders) project();
     map.addObservation(id, i, registration(id, i, k, attempt.verdict));
+  }
   return attempt;
 }
 

@@ -32,6 +32,16 @@ std::vector<Pose3> registeredPoses(const PointInitialisation& result) {
   return poses;
 }
 
+// The initialiser's BAs solve on graph_schur (deterministic for a thread count); its global
+// BAs end when their cost stalls, its local BAs run to their tolerances.
+TEST(PointInitialiserOptions, GlobalBaEndsWhenItsCostStalls) {
+  const PointInitialiserOptions options;
+  EXPECT_EQ(options.global_ba.linear_solver, LinearSolver::kGraphSchur);
+  EXPECT_EQ(options.local_ba.linear_solver, LinearSolver::kGraphSchur);
+  EXPECT_EQ(options.global_ba.stall_iterations, 5);
+  EXPECT_EQ(options.local_ba.stall_iterations, 0);
+}
+
 TEST(PointInitialiser, RecoversThePlanarOrbitUpToSimilarity) {
   const PlanarScene scene = orbitScene(16);
   const PointInitialisation result = initialise(scene, {});

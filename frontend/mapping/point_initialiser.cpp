@@ -33,7 +33,7 @@ OptimizerOptions PointInitialiserOptions::defaultGlobalSolver() {
   o.max_iterations = 30;
   // Most of the map's global BAs ran into the 30-iteration limit on a cost falling by less than
   // 0.1 % over 5 iterations: the stall test ends them 4x sooner with the initialiser's ATE within
-  // 0.5 % on the six real sets (docs/benchmarks.md, "A budget for re-association's global BAs").
+  // 0.7 % on the six real sets (docs/benchmarks.md, "A budget for re-association's global BAs").
   o.stall_iterations = 5;
   return o;
 }

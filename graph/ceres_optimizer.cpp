@@ -111,6 +111,11 @@ OptimizationSummary optimize(const FactorGraph& graph, Values* values, const Pro
   summary.usable = ceres_summary.IsSolutionUsable();
   summary.termination = ceres::TerminationTypeToString(ceres_summary.termination_type);
   summary.message = ceres_summary.message;
+  if (ceres_summary.termination_type == ceres::USER_SUCCESS) {
+    // Only IterationHook ends a solve this way: a stalled cost, converged as in graph_schur.
+    summary.termination = "CONVERGENCE";
+    summary.message = "Cost stalled.";
+  }
   summary.linear_solver = ceres::LinearSolverTypeToString(ceres_summary.linear_solver_type_used);
   summary.num_residuals = ceres_summary.num_residuals;
   summary.num_effective_parameters = ceres_summary.num_effective_parameters;

@@ -241,7 +241,7 @@ SchedulerOptions defaultGlobalBundleAdjustmentOptions() {
   SchedulerOptions options;
   options.optimizer = defaultPipelineOptimizerOptions();
   // Near its minimum the nearest-edge cost's jumps keep Levenberg-Marquardt alternating rejected
-  // steps with kept ones worth a millionth (the last 6-13 of Pavilion's 30-50 iterations a
+  // steps with kept ones worth a millionth (the last 5-13 of Pavilion's 30-50 iterations a
   // solve); on the six real sets the stall test took 9 % off the global BA iterations left
   // after reassociation_interim_iterations' budget, with the same ATEs in 29 of 30 runs
   // (docs/benchmarks.md, "A budget for re-association's global BAs").
@@ -502,7 +502,8 @@ Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const Keyframe
     attempt.polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera,
                                       projectionSamples(), occluders ? &attempt.depths : nullptr);
   };
-  if (explained || occluders) project();
+  const bool masked = explained || occluders;
+  if (masked) project();
   if ((explained && fractionOnMask(attempt.polyline, *explained) > 0.5) ||
       (occluders && occluders->fractionOccluded(attempt.polyline, attempt.depths) > 0.5)) {
     attempt.explained_elsewhere = true;
@@ -510,7 +511,7 @@ Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const Keyframe
   }
   attempt.verdict = registerSegment(segment, view, curve.segments[i].history(), checks);
   if (attempt.verdict.registered) {
-    if (!explained && !occluders) project();
+    if (!masked) project();
     map.addObservation(id, i, registration(id, i, k, attempt.verdict));
   }
   return attempt;
@@ -1062,13 +1063,11 @@ PipelineResult Pipeline::finish() {
   }
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
     const int rounds = impl.options.reassociation_rounds;
+    const int budget = impl.options.reassociation_interim_iterations;
     // An interim BA (one a re-association round follows) runs on the budget; the last does not.
-    bool budgeted = false;
     const auto globalBa = [&](bool interim) {
       SchedulerOptions scheduler = impl.options.global_ba;
-      const int budget = impl.options.reassociation_interim_iterations;
-      budgeted = interim && budget > 0;
-      if (budgeted) {
+      if (interim && budget > 0) {
         scheduler.optimizer.max_iterations = std::min(scheduler.optimizer.max_iterations, budget);
       }
       ScheduleReport report = impl.bundleAdjust(CurveSelection::kPromoted, scheduler,
@@ -1085,9 +1084,10 @@ PipelineResult Pipeline::finish() {
       checked_since_ba = drop;
       ReassociationRound round;
       impl.reassociate(&round);
-      // A round that adds nothing ends them; after a budgeted BA its own BA still converges.
+      // A round that adds nothing ends them; the BA before it was interim, so under a budget
+      // the round's own BA still runs to convergence.
       const bool last = r + 1 == rounds || round.added_observations == 0;
-      if (round.added_observations == 0 && !budgeted) break;
+      if (round.added_observations == 0 && budget == 0) break;
       checked_since_ba = false;
       round.global_ba = globalBa(!last);
       result.reassociation.push_back(std::move(round));

@@ -35,6 +35,10 @@ TEST(PipelineOptions, ValidateNamesTheStageAndField) {
               testing::ThrowsMessage<InvalidOptions>(
                   testing::HasSubstr("PipelineOptions.reassociation_interim_iterations")));
   options = {};
+  options.global_ba.optimizer.stall_iterations = -1;
+  EXPECT_THAT([&] { options.validate(); },
+              testing::ThrowsMessage<InvalidOptions>(testing::HasSubstr("stall_iterations")));
+  options = {};
   options.global_ba.optimizer.stall_tolerance = 0.0;
   EXPECT_THAT([&] { options.validate(); },
               testing::ThrowsMessage<InvalidOptions>(testing::HasSubstr("stall_tolerance")));

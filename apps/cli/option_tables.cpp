@@ -457,6 +457,9 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
       .boolean("track_keyframe_pose", "track-keyframe-pose", &o->track_keyframe_pose,
                "Refine a new keyframe's starting pose against the map before registration")
       .nested("tracking")
+      .threads("registration_threads", "registration-threads", &o->registration_threads,
+               "Threads trying the map's segments in a keyframe (the result does not depend on "
+               "it)")
       .number("explained_radius_px", "explained-radius", &o->explained_radius_px,
               "Chain pixels this close to a registered segment seed no new curve (px)")
       .boolean("point_depth_range", "point-depth-range", &o->point_depth_range,

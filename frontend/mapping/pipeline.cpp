@@ -11,6 +11,7 @@
 #include "core/clock.h"
 #include "core/errors.h"
 #include "core/nearest_edge_field.h"
+#include "core/parallel.h"
 #include "factors/point_bundle_adjustment.h"
 #include "factors/pose_variables.h"
 #include "frontend/mapping/keyframe_selector.h"
@@ -307,6 +308,8 @@ void PipelineOptions::validate() const {
           point_depth_margin, "finite and >= 1");
   require(std::isfinite(scene_scale) && scene_scale >= 0.0, "scene_scale", scene_scale,
           "must be finite and >= 0 (0 derives it)");
+  require(registration_threads >= 1 && registration_threads <= 64, "registration_threads",
+          registration_threads, "in [1, 64]");
   require(depth_reference_candidates >= 1, "depth_reference_candidates", depth_reference_candidates,
           ">= 1");
   require(reassociation_rounds >= 0, "reassociation_rounds", reassociation_rounds, ">= 0");
@@ -346,7 +349,12 @@ struct Pipeline::Impl {
   }
   void addKeyframe(const PipelineFrame& frame, const KeyframeImage& image, KeyframeStats* stats);
   void trackPose(Keyframe* keyframe);
-  /// One attempt to register segment i of curve `id` in keyframe k (see tryRegister).
+  /// Segment i of curve `id`.
+  struct SegmentRef {
+    int id;
+    int i;
+  };
+  /// One attempt to register a segment in keyframe k (see attemptRegistration).
   struct SegmentAttempt {
     /// Skipped: most of it lies on already explained edges, or behind a nearer curve.
     bool explained_elsewhere = false;
@@ -355,9 +363,14 @@ struct Pipeline::Impl {
     std::vector<cv::Point> polyline;
     std::vector<double> depths;  ///< Its vertices' depths, with the occlusion check.
   };
-  SegmentAttempt tryRegister(int k, const KeyframeView& view, int id, int i,
-                             const CorrespondenceOptions& checks, const cv::Mat* explained,
-                             const NearestCurveDepths* occluders = nullptr);
+  SegmentAttempt attemptRegistration(int k, const KeyframeView& view, SegmentRef segment,
+                                     const CorrespondenceOptions& checks, const cv::Mat* explained,
+                                     const NearestCurveDepths* occluders) const;
+  std::vector<SegmentAttempt> attemptAll(int k, const KeyframeView& view,
+                                         const std::vector<SegmentRef>& segments,
+                                         const CorrespondenceOptions& checks,
+                                         const cv::Mat* explained) const;
+  void addRegistration(int k, SegmentRef segment, const SegmentAttempt& attempt);
   void registerTier(int k, CurveState state, bool skip_explained, cv::Mat* explained,
                     KeyframeStats* stats);
   void registerMap(int k, cv::Mat* explained, KeyframeStats* stats);
@@ -485,21 +498,19 @@ void Pipeline::Impl::trackPose(Keyframe* keyframe) {
   if (summary.usable) keyframe->cam_from_world = extractPoses(problem.values, 1)[0];
 }
 
-// Projects segment i of curve `id` into keyframe k and, unless more than half of it lies on
-// `explained` (when given: edges another curve explains, which it must not take over), runs the
-// correspondence checks and adds the observation they accept.
-Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const KeyframeView& view, int id,
-                                                           int i,
-                                                           const CorrespondenceOptions& checks,
-                                                           const cv::Mat* explained,
-                                                           const NearestCurveDepths* occluders) {
-  const MapCurve& curve = map.curve(id);
-  const BezierSegmentParams segment = curve.curve.segment(i);
+// Projects `segment` into keyframe k and, unless more than half of it lies on `explained` (when
+// given: edges another curve explains, which it must not take over) or behind `occluders`, runs
+// the correspondence checks. Reads the map only, so attempts may run concurrently.
+Pipeline::Impl::SegmentAttempt Pipeline::Impl::attemptRegistration(
+    int k, const KeyframeView& view, SegmentRef segment, const CorrespondenceOptions& checks,
+    const cv::Mat* explained, const NearestCurveDepths* occluders) const {
+  const MapCurve& curve = map.curve(segment.id);
+  const BezierSegmentParams params = curve.curve.segment(segment.i);
   SegmentAttempt attempt;
   // Every curve is tried in every keyframe and few register: the projection is drawn only for
   // the two masks and for a segment that registered. Depths only for the occlusion check.
   const auto project = [&] {
-    attempt.polyline = projectSegment(segment, keyframes[k].cam_from_world, *camera,
+    attempt.polyline = projectSegment(params, keyframes[k].cam_from_world, *camera,
                                       projectionSamples(), occluders ? &attempt.depths : nullptr);
   };
   const bool masked = explained || occluders;
@@ -509,30 +520,53 @@ Pipeline::Impl::SegmentAttempt Pipeline::Impl::tryRegister(int k, const Keyframe
     attempt.explained_elsewhere = true;
     return attempt;
   }
-  attempt.verdict = registerSegment(segment, view, curve.segments[i].history(), checks);
-  if (attempt.verdict.registered) {
-    if (!masked) project();
-    map.addObservation(id, i, registration(id, i, k, attempt.verdict));
-  }
+  attempt.verdict = registerSegment(params, view, curve.segments[segment.i].history(), checks);
+  if (attempt.verdict.registered && !masked) project();
   return attempt;
+}
+
+// attemptRegistration for each of `segments` in keyframe k against one fixed `explained` mask,
+// spread over registration_threads threads; the attempts in the order of `segments`.
+std::vector<Pipeline::Impl::SegmentAttempt> Pipeline::Impl::attemptAll(
+    int k, const KeyframeView& view, const std::vector<SegmentRef>& segments,
+    const CorrespondenceOptions& checks, const cv::Mat* explained) const {
+  std::vector<SegmentAttempt> attempts(segments.size());
+  // Interleaved, since the segments of one curve cost alike and curves differ.
+  const int threads = options.registration_threads;
+  runInParallel(threads, [&](int t) {
+    for (std::size_t s = t; s < segments.size(); s += threads) {
+      attempts[s] = attemptRegistration(k, view, segments[s], checks, explained, nullptr);
+    }
+  });
+  return attempts;
+}
+
+void Pipeline::Impl::addRegistration(int k, SegmentRef segment, const SegmentAttempt& attempt) {
+  map.addObservation(segment.id, segment.i,
+                     registration(segment.id, segment.i, k, attempt.verdict));
 }
 
 void Pipeline::Impl::registerTier(int k, CurveState state, bool skip_explained, cv::Mat* explained,
                                   KeyframeStats* stats) {
-  const KeyframeView view = viewOf(keyframes[k], *camera);
-  std::vector<std::vector<cv::Point>> registered;
+  std::vector<SegmentRef> segments;
   for (const int id : map.curvesIn(state)) {
-    for (int i = 0; i < map.curve(id).curve.numSegments(); ++i) {
-      SegmentAttempt attempt =
-          tryRegister(k, view, id, i, options.correspondence, skip_explained ? explained : nullptr);
-      if (attempt.explained_elsewhere) {
-        ++stats->rejected_duplicate;
-      } else if (!attempt.verdict.registered) {
-        countRejection(attempt.verdict.failed_check, stats);
-      } else {
-        ++stats->registered_segments;
-        if (!attempt.polyline.empty()) registered.push_back(std::move(attempt.polyline));
-      }
+    for (int i = 0; i < map.curve(id).curve.numSegments(); ++i) segments.push_back({id, i});
+  }
+  // The tier's attempts all read the mask as the earlier tiers left it.
+  std::vector<SegmentAttempt> attempts =
+      attemptAll(k, viewOf(keyframes[k], *camera), segments, options.correspondence,
+                 skip_explained ? explained : nullptr);
+  std::vector<std::vector<cv::Point>> registered;
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    SegmentAttempt& attempt = attempts[s];
+    if (attempt.explained_elsewhere) {
+      ++stats->rejected_duplicate;
+    } else if (!attempt.verdict.registered) {
+      countRejection(attempt.verdict.failed_check, stats);
+    } else {
+      addRegistration(k, segments[s], attempt);
+      ++stats->registered_segments;
+      if (!attempt.polyline.empty()) registered.push_back(std::move(attempt.polyline));
     }
   }
   cv::polylines(*explained, registered, false, cv::Scalar(255), explainedThickness());
@@ -566,30 +600,46 @@ void Pipeline::Impl::reassociate(ReassociationRound* round) {
   }
 }
 
-// Re-association in keyframe k of the segments of curves `ids` it does not observe yet.
+// Re-association in keyframe k of the segments of curves `ids` it does not observe yet. Without
+// masks a keyframe's attempts are independent (each segment is tried once, and only its own
+// registration changes its history) and run together; with them each registration extends the
+// masks the next attempt reads.
 void Pipeline::Impl::reassociateIn(int k, const std::vector<int>& ids,
                                    const CorrespondenceOptions& checks, ReassociationRound* round) {
   const KeyframeView view = viewOf(keyframes[k], *camera);
+  std::vector<SegmentRef> segments;
+  for (const int id : ids) {
+    for (int i = 0; i < map.curve(id).curve.numSegments(); ++i) {
+      if (!map.curve(id).segments[i].observedIn(k)) segments.push_back({id, i});
+    }
+  }
+  if (!options.reassociation_skip_explained && !options.reassociation_skip_occluded) {
+    const std::vector<SegmentAttempt> attempts = attemptAll(k, view, segments, checks, nullptr);
+    for (std::size_t s = 0; s < segments.size(); ++s) {
+      if (!attempts[s].verdict.registered) continue;
+      addRegistration(k, segments[s], attempts[s]);
+      ++round->added_observations;
+    }
+    return;
+  }
   cv::Mat explained;
   if (options.reassociation_skip_explained) explained = explainedEdges(k);
   std::optional<NearestCurveDepths> occluders;
   if (options.reassociation_skip_occluded) occluders = nearestCurveDepths(k);
-  for (const int id : ids) {
-    for (int i = 0; i < map.curve(id).curve.numSegments(); ++i) {
-      if (map.curve(id).segments[i].observedIn(k)) continue;
-      const SegmentAttempt attempt =
-          tryRegister(k, view, id, i, checks, explained.empty() ? nullptr : &explained,
-                      occluders ? &*occluders : nullptr);
-      round->left_to_other_curves += attempt.explained_elsewhere;
-      if (!attempt.verdict.registered) continue;
-      ++round->added_observations;
-      if (attempt.polyline.empty()) continue;
-      if (!explained.empty()) {
-        cv::polylines(explained, std::vector<std::vector<cv::Point>>{attempt.polyline}, false,
-                      cv::Scalar(255), explainedThickness());
-      }
-      if (occluders) occluders->add(attempt.polyline, attempt.depths);
+  for (const SegmentRef& segment : segments) {
+    const SegmentAttempt attempt =
+        attemptRegistration(k, view, segment, checks, explained.empty() ? nullptr : &explained,
+                            occluders ? &*occluders : nullptr);
+    round->left_to_other_curves += attempt.explained_elsewhere;
+    if (!attempt.verdict.registered) continue;
+    addRegistration(k, segment, attempt);
+    ++round->added_observations;
+    if (attempt.polyline.empty()) continue;
+    if (!explained.empty()) {
+      cv::polylines(explained, std::vector<std::vector<cv::Point>>{attempt.polyline}, false,
+                    cv::Scalar(255), explainedThickness());
     }
+    if (occluders) occluders->add(attempt.polyline, attempt.depths);
   }
 }
 

@@ -186,6 +186,12 @@ struct PipelineOptions {
   bool track_keyframe_pose = false;
   /// Solver of that pose refinement (max_iterations per keyframe).
   OptimizerOptions tracking = defaultPipelineOptimizerOptions();
+  /// Threads that try the map's segments in a keyframe, during the incremental registration and
+  /// re-association (count, in [1, 64]; the result does not depend on it: every attempt only
+  /// reads the map, and the map takes the registrations in the serial order). Re-association
+  /// with reassociation_skip_explained or reassociation_skip_occluded stays on one thread: each
+  /// registration there changes the masks the next attempt reads.
+  int registration_threads = 1;
   /// Chain pixels within this distance of the projection of a segment registered in the
   /// keyframe count as explained by it; only runs of unexplained pixels (at least
   /// chains.min_length_px long) seed new curves (px). Finite, >= 0.

@@ -296,6 +296,39 @@ TEST(Pipeline, InterimGlobalBasStopAtTheirBudgetAndTheLastRunsOn) {
   EXPECT_TRUE(last.converged) << last.stop_reason;
 }
 
+// Registration tries a keyframe's segments on several threads; the map takes them in the serial
+// order, so the run does not depend on the thread count, re-association included.
+TEST(Pipeline, RegistrationOnSeveralThreadsGivesTheSameRun) {
+  const PlanarScene scene = fiveFrameOrbit();
+  const auto run = [&scene](int threads) {
+    PipelineOptions options;
+    options.reassociation_rounds = 1;
+    options.registration_threads = threads;
+    Pipeline pipeline(*scene.camera, options);
+    for (std::size_t i = 0; i < scene.images.size(); ++i) {
+      pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
+    }
+    return pipeline.finish();
+  };
+  const PipelineResult serial = run(1);
+  const PipelineResult parallel = run(3);
+  ASSERT_EQ(serial.reassociation.size(), 1u);
+  ASSERT_EQ(parallel.reassociation.size(), 1u);
+  EXPECT_GT(serial.reassociation[0].added_observations, 0);
+  EXPECT_EQ(parallel.reassociation[0].added_observations,
+            serial.reassociation[0].added_observations);
+  ASSERT_EQ(parallel.curves.size(), serial.curves.size());
+  for (std::size_t c = 0; c < serial.curves.size(); ++c) {
+    EXPECT_EQ(parallel.curves[c].sample(4), serial.curves[c].sample(4)) << "curve " << c;
+  }
+  ASSERT_EQ(parallel.keyframe_cam_from_world.size(), serial.keyframe_cam_from_world.size());
+  for (std::size_t k = 0; k < serial.keyframe_cam_from_world.size(); ++k) {
+    EXPECT_EQ(parallel.keyframe_cam_from_world[k].translation(),
+              serial.keyframe_cam_from_world[k].translation())
+        << "keyframe " << k;
+  }
+}
+
 // The five frames of the small orbit with global BA and one re-association round, every length
 // of the scene (true and initial poses) multiplied by `unit`: the same scene in metres
 // (unit 1) or in millimetres (unit 1000).

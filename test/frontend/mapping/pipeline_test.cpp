@@ -78,6 +78,16 @@ TEST(PipelineOptions, ValidateChecksTheReassociationGates) {
   EXPECT_FALSE(PipelineOptions{}.reassociation_skip_explained);
 }
 
+TEST(PipelineOptions, RegistrationThreadsAreBetweenOneAndSixtyFour) {
+  for (const int threads : {0, 65}) {
+    PipelineOptions options;
+    options.registration_threads = threads;
+    EXPECT_THAT([&] { options.validate(); },
+                testing::ThrowsMessage<InvalidOptions>(
+                    testing::HasSubstr("PipelineOptions.registration_threads")));
+  }
+}
+
 // Camera centres along x (pose units) and turns about y (deg): frame 1 has not moved yet, so the
 // scene scale is frame 2's distance, 0.1; the default keyframe thresholds are 0.74 scene scales
 // and 2 deg.

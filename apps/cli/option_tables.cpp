@@ -435,6 +435,9 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
               &o->reassociation_interim_iterations,
               "Most iterations of a global BA that a re-association round follows (0: "
               "--global-ba-max-iterations; the last global BA always runs to it)")
+      .number("last_global_ba_kernel_width", "last-global-ba-kernel-width",
+              &o->last_global_ba_kernel_width,
+              "Kernel width of the last global BA (sigmas; 0: --ba-kernel-width)")
       .boolean("reassociation_skip_explained", "reassociation-skip-explained",
                &o->reassociation_skip_explained,
                "Re-association leaves edges that curves observed in a keyframe already explain")

@@ -308,6 +308,10 @@ void PipelineOptions::validate() const {
           point_depth_margin, "finite and >= 1");
   require(std::isfinite(scene_scale) && scene_scale >= 0.0, "scene_scale", scene_scale,
           "must be finite and >= 0 (0 derives it)");
+  require(last_global_ba_kernel_width == 0.0 ||
+              (std::isfinite(last_global_ba_kernel_width) && last_global_ba_kernel_width > 0.0),
+          "last_global_ba_kernel_width", last_global_ba_kernel_width,
+          "must be 0 (ba.kernel_width) or finite and > 0");
   require(registration_threads >= 1 && registration_threads <= 64, "registration_threads",
           registration_threads, "in [1, 64]");
   require(depth_reference_candidates >= 1, "depth_reference_candidates", depth_reference_candidates,
@@ -404,7 +408,8 @@ struct Pipeline::Impl {
   std::vector<int> addPointsTo(CurveBundleAdjustmentInput* input) const;
   void checkFit(bool drop);
   ScheduleReport bundleAdjust(CurveSelection selection, const SchedulerOptions& scheduler,
-                              bool refine_poses, CurveSampleCounts* samples);
+                              const CurveBundleAdjustmentOptions& ba, bool refine_poses,
+                              CurveSampleCounts* samples);
   SceneExtent currentExtent() const;
   void checkCurves(bool drop);
 
@@ -889,8 +894,9 @@ std::vector<int> Pipeline::Impl::addPointsTo(CurveBundleAdjustmentInput* input) 
 }
 
 ScheduleReport Pipeline::Impl::bundleAdjust(CurveSelection selection,
-                                            const SchedulerOptions& scheduler, bool refine_poses,
-                                            CurveSampleCounts* samples) {
+                                            const SchedulerOptions& scheduler,
+                                            const CurveBundleAdjustmentOptions& ba,
+                                            bool refine_poses, CurveSampleCounts* samples) {
   std::vector<int> ids;
   CurveBundleAdjustmentInput input = bundleInput(selection, &ids);
   if (input.observations.empty()) return {};
@@ -900,10 +906,10 @@ ScheduleReport Pipeline::Impl::bundleAdjust(CurveSelection selection,
                               scheduler.local_window, static_cast<int>(keyframes.size()) - 1);
   }
   const std::vector<int> point_ids = addPointsTo(&input);
-  CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options.ba);
+  CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, ba);
   if (!refine_poses) problem.config.setConstant(VariableCategory::kPose);
   SchedulerOptions schedule = scheduler;
-  schedule.fix_first_pose = options.ba.fix_first_pose;
+  schedule.fix_first_pose = ba.fix_first_pose;
   const ScheduleReport report =
       runSchedule(problem.graph, &problem.values, problem.config, schedule);
   const std::vector<Pose3> refined = extractPoses(problem.values, keyframes.size());
@@ -1030,7 +1036,7 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   if (keyframes.size() >= 2 && map.count(CurveState::kGlobal) > 0) {
     const Clock::time_point local_ba_start = Clock::now();
     const ScheduleReport report = bundleAdjust(CurveSelection::kGlobal, options.local_ba,
-                                               options.local_ba_refines_poses, nullptr);
+                                               options.ba, options.local_ba_refines_poses, nullptr);
     // The whole call: building the window's graph and writing the curves back count too.
     stats.local_ba_seconds = secondsSince(local_ba_start);
     stats.local_ba_initial_cost = report.initial_cost;
@@ -1114,13 +1120,18 @@ PipelineResult Pipeline::finish() {
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
     const int rounds = impl.options.reassociation_rounds;
     const int budget = impl.options.reassociation_interim_iterations;
-    // An interim BA (one a re-association round follows) runs on the budget; the last does not.
+    // An interim BA (one a re-association round follows) runs on the budget; the last does not,
+    // and may weigh the edges with its own kernel width.
     const auto globalBa = [&](bool interim) {
       SchedulerOptions scheduler = impl.options.global_ba;
       if (interim && budget > 0) {
         scheduler.optimizer.max_iterations = std::min(scheduler.optimizer.max_iterations, budget);
       }
-      ScheduleReport report = impl.bundleAdjust(CurveSelection::kPromoted, scheduler,
+      CurveBundleAdjustmentOptions ba = impl.options.ba;
+      if (!interim && impl.options.last_global_ba_kernel_width > 0.0) {
+        ba.kernel_width = impl.options.last_global_ba_kernel_width;
+      }
+      ScheduleReport report = impl.bundleAdjust(CurveSelection::kPromoted, scheduler, ba,
                                                 /*refine_poses=*/true, &result.final_samples);
       ++impl.global_bas;
       return report;

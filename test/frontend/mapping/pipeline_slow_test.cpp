@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <future>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
@@ -270,18 +271,23 @@ TEST(Pipeline, DropsCurvesOutsideTheExtentAndJudgesTheRun) {
   EXPECT_GT(sanity.pose_move.spacings(), 1e-6);
 }
 
-// A budget on the global BAs that a re-association round follows: each stops at it, and the
-// last one runs to the global BA's own limits.
-TEST(Pipeline, InterimGlobalBasStopAtTheirBudgetAndTheLastRunsOn) {
+// The five frames of the small orbit, global BA and re-association as `options` say.
+PipelineResult runFiveFrames(const PipelineOptions& options) {
   const PlanarScene scene = fiveFrameOrbit();
-  PipelineOptions options;
-  options.reassociation_rounds = 2;
-  options.reassociation_interim_iterations = 2;
   Pipeline pipeline(*scene.camera, options);
   for (std::size_t i = 0; i < scene.images.size(); ++i) {
     pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
   }
-  const PipelineResult result = pipeline.finish();
+  return pipeline.finish();
+}
+
+// A budget on the global BAs that a re-association round follows: each stops at it, and the
+// last one runs to the global BA's own limits.
+TEST(Pipeline, InterimGlobalBasStopAtTheirBudgetAndTheLastRunsOn) {
+  PipelineOptions options;
+  options.reassociation_rounds = 2;
+  options.reassociation_interim_iterations = 2;
+  const PipelineResult result = runFiveFrames(options);
   ASSERT_FALSE(result.reassociation.empty());
   std::vector<const ScheduleReport*> interim = {&result.global_ba};
   for (std::size_t r = 0; r + 1 < result.reassociation.size(); ++r) {
@@ -296,24 +302,24 @@ TEST(Pipeline, InterimGlobalBasStopAtTheirBudgetAndTheLastRunsOn) {
   EXPECT_TRUE(last.converged) << last.stop_reason;
 }
 
+// The five frames with one re-association round, the defaults changed by `change`.
+PipelineResult runFiveFramesOneRound(const std::function<void(PipelineOptions*)>& change) {
+  PipelineOptions options;
+  options.reassociation_rounds = 1;
+  change(&options);
+  PipelineResult result = runFiveFrames(options);
+  EXPECT_EQ(result.reassociation.size(), 1u);
+  return result;
+}
+
 // Registration tries a keyframe's segments on several threads; the map takes them in the serial
 // order, so the run does not depend on the thread count, re-association included.
 TEST(Pipeline, RegistrationOnSeveralThreadsGivesTheSameRun) {
-  const PlanarScene scene = fiveFrameOrbit();
-  const auto run = [&scene](int threads) {
-    PipelineOptions options;
-    options.reassociation_rounds = 1;
-    options.registration_threads = threads;
-    Pipeline pipeline(*scene.camera, options);
-    for (std::size_t i = 0; i < scene.images.size(); ++i) {
-      pipeline.addFrame({scene.timestamps[i], scene.images[i], scene.initial_cam_from_world[i]});
-    }
-    return pipeline.finish();
-  };
-  const PipelineResult serial = run(1);
-  const PipelineResult parallel = run(3);
-  ASSERT_EQ(serial.reassociation.size(), 1u);
-  ASSERT_EQ(parallel.reassociation.size(), 1u);
+  const PipelineResult serial = runFiveFramesOneRound([](PipelineOptions*) {});
+  const PipelineResult parallel =
+      runFiveFramesOneRound([](PipelineOptions* o) { o->registration_threads = 3; });
+  ASSERT_FALSE(serial.reassociation.empty());
+  ASSERT_FALSE(parallel.reassociation.empty());
   EXPECT_GT(serial.reassociation[0].added_observations, 0);
   EXPECT_EQ(parallel.reassociation[0].added_observations,
             serial.reassociation[0].added_observations);
@@ -327,6 +333,21 @@ TEST(Pipeline, RegistrationOnSeveralThreadsGivesTheSameRun) {
               serial.keyframe_cam_from_world[k].translation())
         << "keyframe " << k;
   }
+}
+
+// The global BA after the last re-association round weighs the edges with its own kernel width;
+// the BAs before it keep --ba-kernel-width, so the runs agree until that solve.
+TEST(Pipeline, TheLastGlobalBaTakesItsOwnKernelWidth) {
+  const PipelineResult same = runFiveFramesOneRound([](PipelineOptions*) {});
+  const PipelineResult narrow =
+      runFiveFramesOneRound([](PipelineOptions* o) { o->last_global_ba_kernel_width = 0.5; });
+  ASSERT_FALSE(same.reassociation.empty());
+  ASSERT_FALSE(narrow.reassociation.empty());
+  EXPECT_EQ(narrow.global_ba.initial_cost, same.global_ba.initial_cost);
+  EXPECT_EQ(narrow.global_ba.final_cost, same.global_ba.final_cost);
+  // The same poses and curves, weighed by a narrower kernel: a lower cost.
+  EXPECT_LT(narrow.reassociation[0].global_ba.initial_cost,
+            same.reassociation[0].global_ba.initial_cost);
 }
 
 // The five frames of the small orbit with global BA and one re-association round, every length

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <limits>
 #include <vector>
 
 #include "core/angles.h"
@@ -76,6 +77,17 @@ TEST(PipelineOptions, ValidateChecksTheReassociationGates) {
                     testing::HasSubstr("PipelineOptions.reassociation_occluder_depth_ratio")));
   }
   EXPECT_FALSE(PipelineOptions{}.reassociation_skip_explained);
+}
+
+TEST(PipelineOptions, TheLastGlobalBaKernelWidthIsZeroOrPositive) {
+  EXPECT_EQ(PipelineOptions{}.last_global_ba_kernel_width, 0.0);
+  for (const double width : {-1.0, std::numeric_limits<double>::infinity()}) {
+    PipelineOptions options;
+    options.last_global_ba_kernel_width = width;
+    EXPECT_THAT([&] { options.validate(); },
+                testing::ThrowsMessage<InvalidOptions>(
+                    testing::HasSubstr("PipelineOptions.last_global_ba_kernel_width")));
+  }
 }
 
 TEST(PipelineOptions, RegistrationThreadsAreBetweenOneAndSixtyFour) {

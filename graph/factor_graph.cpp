@@ -37,6 +37,14 @@ std::map<std::string, FactorTypeCost> FactorGraph::costByType(const Values& valu
       costs[i] = factors_[i]->cost(values);
     }
   });
+  return sumByType(costs);
+}
+
+std::map<std::string, FactorTypeCost> FactorGraph::sumByType(
+    const std::vector<double>& costs) const {
+  const int n = static_cast<int>(factors_.size());
+  CURVESFM_CHECK(costs.size() == factors_.size())
+      << "FactorGraph::sumByType: " << costs.size() << " costs for " << n << " factors";
   std::map<std::string, FactorTypeCost> by_type;
   const char* type = nullptr;
   FactorTypeCost* entry = nullptr;

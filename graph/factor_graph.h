@@ -45,6 +45,9 @@ class FactorGraph {
   /// Cost per factor typeName() at `values`, the factors evaluated on up to `num_threads`
   /// threads (the result does not depend on their number).
   std::map<std::string, FactorTypeCost> costByType(const Values& values, int num_threads = 1) const;
+  /// The per-type sums of `costs`, factor i's cost at costs[i] (size()), added in the factors'
+  /// order as costByType does: a solver that evaluated every factor already need not again.
+  std::map<std::string, FactorTypeCost> sumByType(const std::vector<double>& costs) const;
 
  private:
   std::vector<FactorPtr> factors_;

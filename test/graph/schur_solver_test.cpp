@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <string>
+
 #include "graph/levenberg_marquardt.h"
 #include "graph/optimizer.h"
 #include "test/graph/toy_scene.h"
@@ -113,6 +116,32 @@ TEST(GraphSchur, StructureOnlyWithEveryPoseHeld) {
   optimize(scene.graph, &ceres, config, tight(LinearSolver::kSparseSchur));
   EXPECT_EQ(schur.ordering, "graph_schur (6 groups eliminated, 0 poses reduced)");
   expectSameVariables(ours, ceres, 1e-6);
+}
+
+// The costs per factor type come from the solve's own linearisations: the same as evaluating
+// every factor at the start and at the solution, on a solve that rejects some steps.
+TEST(GraphSchur, ReportsTheCostsPerTypeAtTheStartAndTheSolution) {
+  const Scene scene = makeScene();
+  Values values = scene.start;
+  OptimizerOptions options;
+  options.linear_solver = LinearSolver::kGraphSchur;
+  options.initial_trust_region_radius = 1e8;  // Undamped first steps, some rejected.
+  const OptimizationSummary summary = optimize(scene.graph, &values, firstPoseHeld(), options);
+  ASSERT_GT(summary.iterations, 0);
+  ASSERT_NE(summary.full_report.find("Unsuccessful steps "), std::string::npos);
+  EXPECT_EQ(summary.full_report.find("Unsuccessful steps 0\n"), std::string::npos)
+      << summary.full_report;
+  const auto expectSame = [](const std::map<std::string, FactorTypeCost>& actual,
+                             const std::map<std::string, FactorTypeCost>& expected) {
+    ASSERT_EQ(actual.size(), expected.size());
+    for (const auto& [type, cost] : expected) {
+      EXPECT_EQ(actual.at(type).count, cost.count) << type;
+      EXPECT_NEAR(actual.at(type).cost, cost.cost, 1e-12 * cost.cost) << type;
+    }
+  };
+  expectSame(summary.initial_cost_by_type, scene.graph.costByType(scene.start));
+  expectSame(summary.final_cost_by_type, scene.graph.costByType(values));
+  EXPECT_LT(summary.final_cost, summary.initial_cost);
 }
 
 TEST(GraphSchur, TwoThreadsAgreeWithOneToRounding) {

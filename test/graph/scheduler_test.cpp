@@ -8,6 +8,7 @@
 #include <set>
 
 #include "core/so3.h"
+#include "test/graph/cost_by_type_expectations.h"
 #include "test/graph/test_factors.h"
 #include "test/support/numerical_jacobian.h"
 
@@ -501,20 +502,12 @@ TEST(Optimize, CostsByTypeAreTheFactorGraphsBeforeAndAfterTheSolve) {
   scene.graph.emplace<PointPriorFactor>(pointKey(1), Eigen::Vector3d(0.0, 0.0, 5.0), huber);
   scene.graph.emplace<PointPriorFactor>(pointKey(2), Eigen::Vector3d(1.0, 0.0, 5.0), cauchy);
   Values values = scene.start;
-  const auto expectSame = [](const std::map<std::string, FactorTypeCost>& actual,
-                             const std::map<std::string, FactorTypeCost>& expected) {
-    ASSERT_EQ(actual.size(), expected.size());
-    for (const auto& [type, cost] : expected) {
-      EXPECT_EQ(actual.at(type).count, cost.count) << type;
-      EXPECT_NEAR(actual.at(type).cost, cost.cost, 1e-14 * cost.cost) << type;
-    }
-  };
   const auto before = scene.graph.costByType(values);
   ProblemConfig config;
   config.setConstant(poseKey(0));
   const OptimizationSummary summary = optimize(scene.graph, &values, config, OptimizerOptions());
-  expectSame(summary.initial_cost_by_type, before);
-  expectSame(summary.final_cost_by_type, scene.graph.costByType(values));
+  testing::expectSameCostsByType(summary.initial_cost_by_type, before, 1e-14);
+  testing::expectSameCostsByType(summary.final_cost_by_type, scene.graph.costByType(values), 1e-14);
   EXPECT_EQ(summary.initial_cost_by_type.at("point_prior").count, 3);
   EXPECT_LT(summary.final_cost_by_type.at("point_in_camera").cost,
             before.at("point_in_camera").cost);

@@ -7,6 +7,7 @@
 
 #include "graph/levenberg_marquardt.h"
 #include "graph/optimizer.h"
+#include "test/graph/cost_by_type_expectations.h"
 #include "test/graph/toy_scene.h"
 
 namespace curvesfm {
@@ -131,16 +132,9 @@ TEST(GraphSchur, ReportsTheCostsPerTypeAtTheStartAndTheSolution) {
   ASSERT_NE(summary.full_report.find("Unsuccessful steps "), std::string::npos);
   EXPECT_EQ(summary.full_report.find("Unsuccessful steps 0\n"), std::string::npos)
       << summary.full_report;
-  const auto expectSame = [](const std::map<std::string, FactorTypeCost>& actual,
-                             const std::map<std::string, FactorTypeCost>& expected) {
-    ASSERT_EQ(actual.size(), expected.size());
-    for (const auto& [type, cost] : expected) {
-      EXPECT_EQ(actual.at(type).count, cost.count) << type;
-      EXPECT_NEAR(actual.at(type).cost, cost.cost, 1e-12 * cost.cost) << type;
-    }
-  };
-  expectSame(summary.initial_cost_by_type, scene.graph.costByType(scene.start));
-  expectSame(summary.final_cost_by_type, scene.graph.costByType(values));
+  testing::expectSameCostsByType(summary.initial_cost_by_type, scene.graph.costByType(scene.start),
+                                 1e-12);
+  testing::expectSameCostsByType(summary.final_cost_by_type, scene.graph.costByType(values), 1e-12);
   EXPECT_LT(summary.final_cost, summary.initial_cost);
 }
 

@@ -1,6 +1,7 @@
 #include "graph/schur_solver.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -72,20 +73,33 @@ struct PoseRun {
 // share of the reduced system goes in as a few large products rather than many small ones.
 constexpr int kMaxPoseGap = 2;
 
-// Structure variables joined by factors, eliminated together, and what one linearisation and
-// one elimination leave of them.
+// Structure variables joined by factors, eliminated together, and what one elimination leaves
+// of them.
 struct Group {
   std::vector<int> factors;
   std::vector<PoseRun> runs;  // Covering the free poses its factors touch, ascending.
   int local_poses = 0;        // Poses the runs cover.
   int dim = 0;
-  Eigen::MatrixXd H;                // Gauss-Newton block of the group (dim x dim) ...
-  Eigen::VectorXd g;                // ... its gradient ...
-  Eigen::MatrixXd W;                // ... and its coupling to its poses (6 local_poses x dim).
   Eigen::MatrixXd L;                // The Cholesky factor of the damped H (lower triangle).
   Eigen::VectorXd u;                // L^-1 g.
   Eigen::VectorXd step;
   double cost = 0.0;
+};
+
+// What one linearisation leaves of a group.
+struct GroupSystem {
+  Eigen::MatrixXd H;  // Gauss-Newton block of the group (dim x dim, lower triangle) ...
+  Eigen::VectorXd g;  // ... its gradient ...
+  Eigen::MatrixXd W;  // ... and its coupling to its poses (6 local_poses x dim).
+};
+
+// The Gauss-Newton system at one point, and every factor's cost there.
+struct Linearization {
+  std::vector<GroupSystem> groups;
+  std::vector<PoseBlock> pose_terms;  // Per pose pair, the sum of the workers' terms.
+  Eigen::VectorXd g_poses;
+  Eigen::VectorXd pose_diagonal;  // The diagonal of the pose-pose terms.
+  std::vector<double> factor_costs;
 };
 
 // Where one column of a factor's Jacobian goes.
@@ -121,8 +135,7 @@ struct Worker {
 };
 
 struct Timings {
-  double linearize = 0.0;
-  double cost = 0.0;
+  double linearize = 0.0;  // Every evaluation: trial steps are linearised as they are tried.
   double eliminate = 0.0;
   double reduced = 0.0;
   double back_substitute = 0.0;
@@ -175,55 +188,62 @@ class GraphSchurProblem {
     }
     splitGroups();
     // Factors with no free key add a constant, as in Ceres' reported costs.
-    factor_costs_.assign(graph_.size(), 0.0);
     fixed_cost_ = 0.0;
+    for (Linearization& linearization : linearizations_) {
+      linearization.groups.resize(groups_.size());
+      linearization.factor_costs.assign(graph_.size(), 0.0);
+    }
     for (const int f : constant_factors_) {
-      factor_costs_[f] = evaluateFactor(variables_.ambient, f, nullptr, false, &workers_[0]);
-      fixed_cost_ += factor_costs_[f];
+      const double cost = evaluateFactor(variables_.ambient, f, nullptr, nullptr, &workers_[0]);
+      for (Linearization& linearization : linearizations_) linearization.factor_costs[f] = cost;
+      fixed_cost_ += cost;
     }
   }
 
-  // Cost per factor type at the last linearisation, i.e. at the solution the solver holds: what
-  // FactorGraph::costByType would give there, without evaluating every factor again.
+  // Cost per factor type at the current linearisation, i.e. at the solution the solver holds:
+  // what FactorGraph::costByType would give there, without evaluating every factor again.
   std::map<std::string, FactorTypeCost> costByTypeAtLinearization() const {
-    return graph_.sumByType(factor_costs_);
+    return graph_.sumByType(current().factor_costs);
   }
 
-  // Cost at x; with `linearize`, also every group's H, g and W and the pose terms
-  // (Triggs-corrected Gauss-Newton, as Ceres).
-  double evaluate(const std::vector<double>& x, bool linearize) {
+  // Cost at x, and the Gauss-Newton system there (Triggs-corrected, as Ceres) in the spare
+  // linearisation: the solve still reads the current one until adoptLinearization(). A trial
+  // step is linearised as it is evaluated, so that a kept step, most of them, needs no second
+  // pass over the factors (whose residuals take most of a linearisation's time); a rejected one
+  // costs its Jacobians for nothing.
+  double linearize(const std::vector<double>& x) {
+    Linearization& into = spare();
     parallel([&](int t) {
       Worker& worker = workers_[t];
-      if (linearize) {
-        worker.pose_terms.assign(pose_pairs_.size(), PoseBlock::Zero());
-        worker.g_poses.setZero();
-      }
+      worker.pose_terms.assign(pose_pairs_.size(), PoseBlock::Zero());
+      worker.g_poses.setZero();
       for (int i = ranges_[t]; i < ranges_[t + 1]; ++i) {
         Group& group = groups_[i];
-        if (linearize) {
-          group.H.setZero(group.dim, group.dim);
-          group.g.setZero(group.dim);
-          group.W.setZero(kPoseDim * group.local_poses, group.dim);
-        }
+        GroupSystem& system = into.groups[i];
+        system.H.setZero(group.dim, group.dim);
+        system.g.setZero(group.dim);
+        system.W.setZero(kPoseDim * group.local_poses, group.dim);
         group.cost = 0.0;
-        for (const int f : group.factors) {
-          group.cost += evaluateFactor(x, f, linearize ? &group : nullptr, linearize, &worker);
-        }
+        for (const int f : group.factors)
+          group.cost += evaluateFactor(x, f, &system, &into, &worker);
       }
     });
     // Factors over poses only (priors, relative poses): few, on this thread.
     double cost = fixed_cost_;
-    for (const int f : pose_factors_)
-      cost += evaluateFactor(x, f, nullptr, linearize, &workers_[0]);
+    for (const int f : pose_factors_) cost += evaluateFactor(x, f, nullptr, &into, &workers_[0]);
     for (const Group& group : groups_) cost += group.cost;
-    if (linearize) sumPoseTerms();
+    sumPoseTerms(&into);
     return cost;
   }
 
+  // The last linearisation becomes the one the solve reads.
+  void adoptLinearization() { current_ = 1 - current_; }
+
   double gradientMaxNorm() const {
-    double most = g_poses_.size() ? g_poses_.lpNorm<Eigen::Infinity>() : 0.0;
-    for (const Group& group : groups_) {
-      if (group.dim) most = std::max(most, group.g.lpNorm<Eigen::Infinity>());
+    const Linearization& at = current();
+    double most = at.g_poses.size() ? at.g_poses.lpNorm<Eigen::Infinity>() : 0.0;
+    for (std::size_t i = 0; i < groups_.size(); ++i) {
+      if (groups_[i].dim) most = std::max(most, at.groups[i].g.lpNorm<Eigen::Infinity>());
     }
     return most;
   }
@@ -240,7 +260,8 @@ class GraphSchurProblem {
     timings->eliminate += secondsSince(start);
 
     start = Clock::now();
-    pose_step_ = -g_poses_;
+    const Linearization& at = current();
+    pose_step_ = -at.g_poses;
     if (pose_step_.size() > 0) {
       for (std::size_t t = 1; t < workers_.size(); ++t) {
         S_.triangularView<Eigen::Lower>() += workers_[t].S;
@@ -253,13 +274,14 @@ class GraphSchurProblem {
 
     start = Clock::now();
     parallel([&](int t) {
-      for (int i = ranges_[t]; i < ranges_[t + 1]; ++i) backSubstitute(&groups_[i]);
+      for (int i = ranges_[t]; i < ranges_[t + 1]; ++i) backSubstitute(i);
     });
-    double gx = g_poses_.dot(pose_step_);
-    double xDx = pose_step_.dot(marquardtDiagonal(pose_diagonal_).cwiseProduct(pose_step_));
-    for (const Group& group : groups_) {
-      gx += group.g.dot(group.step);
-      xDx += group.step.dot(marquardtDiagonal(group.H.diagonal()).cwiseProduct(group.step));
+    double gx = at.g_poses.dot(pose_step_);
+    double xDx = pose_step_.dot(marquardtDiagonal(at.pose_diagonal).cwiseProduct(pose_step_));
+    for (std::size_t i = 0; i < groups_.size(); ++i) {
+      const Group& group = groups_[i];
+      gx += at.groups[i].g.dot(group.step);
+      xDx += group.step.dot(marquardtDiagonal(at.groups[i].H.diagonal()).cwiseProduct(group.step));
     }
     *model_decrease = 0.5 * (-gx + damping * xDx);
     timings->back_substitute += secondsSince(start);
@@ -303,6 +325,9 @@ class GraphSchurProblem {
   }
 
  private:
+  const Linearization& current() const { return linearizations_[current_]; }
+  Linearization& spare() { return linearizations_[1 - current_]; }
+
   void collectSlots(const Values& values, const ProblemConfig& config) {
     variables_ = collectVariableSlots(graph_, values, config);
     plans_.resize(graph_.size());
@@ -426,25 +451,29 @@ class GraphSchurProblem {
     runInParallel(static_cast<int>(workers_.size()), work);
   }
 
-  void sumPoseTerms() {
-    g_poses_ = workers_[0].g_poses;
-    pose_terms_ = workers_[0].pose_terms;
+  void sumPoseTerms(Linearization* into) const {
+    into->g_poses = workers_[0].g_poses;
+    into->pose_terms = workers_[0].pose_terms;
     for (std::size_t t = 1; t < workers_.size(); ++t) {
-      g_poses_ += workers_[t].g_poses;
-      for (std::size_t i = 0; i < pose_terms_.size(); ++i)
-        pose_terms_[i] += workers_[t].pose_terms[i];
+      into->g_poses += workers_[t].g_poses;
+      for (std::size_t i = 0; i < into->pose_terms.size(); ++i)
+        into->pose_terms[i] += workers_[t].pose_terms[i];
     }
-    pose_diagonal_.setZero(reducedDimension());
+    into->pose_diagonal.setZero(reducedDimension());
     for (std::size_t i = 0; i < pose_pairs_.size(); ++i) {
       const PosePair& pair = pose_pairs_[i];
       if (pair.first == pair.second) {
-        pose_diagonal_.segment<kPoseDim>(kPoseDim * pair.first) = pose_terms_[i].diagonal();
+        into->pose_diagonal.segment<kPoseDim>(kPoseDim * pair.first) =
+            into->pose_terms[i].diagonal();
       }
     }
   }
 
-  double evaluateFactor(const std::vector<double>& x, int f, Group* group, bool linearize,
-                        Worker* worker) {
+  // The factor's cost at x; with `into`, also its share of the system there (its group's in
+  // `system`).
+  double evaluateFactor(const std::vector<double>& x, int f, GroupSystem* system,
+                        Linearization* into, Worker* worker) const {
+    const bool linearize = into != nullptr;
     const Factor& factor = *graph_[f];
     const FactorPlan& plan = plans_[f];
     const std::vector<int>& keys = variables_.factor_slots[f];
@@ -470,16 +499,16 @@ class GraphSchurProblem {
     double rho[3];
     noise.kernel.evaluate(s, rho);
     if (linearize) {
-      accumulate(plan, rows, noise.sigma, s, rho, group, worker);
-      factor_costs_[f] = 0.5 * rho[0];
+      accumulate(plan, rows, noise.sigma, s, rho, system, worker);
+      into->factor_costs[f] = 0.5 * rho[0];
     }
     return 0.5 * rho[0];
   }
 
-  // Adds the factor's corrected J^T J and J^T r to its group (H, W, g) and to the worker's pose
-  // terms.
+  // Adds the factor's corrected J^T J and J^T r to its group's system (H's lower triangle, W,
+  // g) and to the worker's pose terms.
   void accumulate(const FactorPlan& plan, int rows, double sigma, double s, const double rho[3],
-                  Group* group, Worker* worker) const {
+                  GroupSystem* group, Worker* worker) const {
     Eigen::MatrixXd& J = worker->J;
     J.resize(rows, plan.free_columns);
     std::vector<ColumnPlace>& places = worker->places;
@@ -515,9 +544,9 @@ class GraphSchurProblem {
       for (int k = 0; k < n; ++k) {
         const ColumnPlace& place = places[k];
         const double value = k >= c ? JtJ(k, c) : JtJ(c, k);
-        if (place.structure >= 0) {
+        if (place.structure >= column) {
           group->H(place.structure, column) += value;
-        } else {
+        } else if (place.structure < 0) {
           group->W(place.w_row, column) += value;
         }
       }
@@ -545,18 +574,19 @@ class GraphSchurProblem {
     worker->eliminated = true;
     for (int i = ranges_[thread]; i < ranges_[thread + 1]; ++i) {
       Group& group = groups_[i];
-      group.L = group.H;
-      group.L.diagonal() += marquardtDiagonal(group.H.diagonal()) * damping;
+      const GroupSystem& system = current().groups[i];
+      group.L = system.H;
+      group.L.diagonal() += marquardtDiagonal(system.H.diagonal()) * damping;
       const dense::MatrixSpan L = dense::blockSpan(group.L, 0, 0, group.dim, group.dim);
       if (!dense::factorLower(L)) {
         worker->eliminated = false;
         return;
       }
-      if (worker->v_storage.size() < group.W.size()) worker->v_storage.resize(group.W.size());
-      Eigen::Map<Eigen::MatrixXd> V(worker->v_storage.data(), group.W.rows(), group.W.cols());
-      V = group.W;
+      if (worker->v_storage.size() < system.W.size()) worker->v_storage.resize(system.W.size());
+      Eigen::Map<Eigen::MatrixXd> V(worker->v_storage.data(), system.W.rows(), system.W.cols());
+      V = system.W;
       dense::solveLowerTransposedRight(L, dense::blockSpan(V, 0, 0, V.rows(), group.dim));
-      group.u = group.g;
+      group.u = system.g;
       group.L.triangularView<Eigen::Lower>().solveInPlace(group.u);
       subtractFromReducedSystem(group, V, &S, &worker->rhs);
     }
@@ -586,15 +616,18 @@ class GraphSchurProblem {
 
   // The pose-pose terms and their damping, into the reduced system's lower triangle.
   void addPoseTerms(double damping) {
+    const Linearization& at = current();
     for (std::size_t i = 0; i < pose_pairs_.size(); ++i) {
       const PosePair& pair = pose_pairs_[i];
-      S_.block<kPoseDim, kPoseDim>(kPoseDim * pair.first, kPoseDim * pair.second) += pose_terms_[i];
+      S_.block<kPoseDim, kPoseDim>(kPoseDim * pair.first, kPoseDim * pair.second) +=
+          at.pose_terms[i];
     }
-    S_.diagonal() += marquardtDiagonal(pose_diagonal_) * damping;
+    S_.diagonal() += marquardtDiagonal(at.pose_diagonal) * damping;
   }
 
   // x_group = A^-1 (-g - W^T x_poses) = L^-T (-u - L^-1 W^T x_poses).
-  void backSubstitute(Group* group) const {
+  void backSubstitute(int i) {
+    Group* group = &groups_[i];
     Eigen::VectorXd poses(kPoseDim * group->local_poses);
     for (const PoseRun& run : group->runs) {
       poses.segment(kPoseDim * run.local, kPoseDim * run.count) =
@@ -602,7 +635,7 @@ class GraphSchurProblem {
     }
     group->step = -group->u;
     if (poses.size()) {
-      Eigen::VectorXd coupling = group->W.transpose() * poses;
+      Eigen::VectorXd coupling = current().groups[i].W.transpose() * poses;
       group->L.triangularView<Eigen::Lower>().solveInPlace(coupling);
       group->step -= coupling;
     }
@@ -619,13 +652,12 @@ class GraphSchurProblem {
   double fixed_cost_ = 0.0;
   int num_poses_ = 0;
   int num_free_ = 0;
-  std::vector<double> factor_costs_;  // Each factor's cost at the last linearisation.
+  // The solve reads linearizations_[current_]; a trial step is linearised into the other.
+  std::array<Linearization, 2> linearizations_;
+  int current_ = 0;
   std::vector<Worker> workers_;
   std::vector<int> ranges_;  // Thread t takes groups [ranges_[t], ranges_[t + 1]).
   std::vector<PosePair> pose_pairs_;
-  std::vector<PoseBlock> pose_terms_;  // Per pose pair, the sum of the workers' terms.
-  Eigen::VectorXd pose_diagonal_;      // The diagonal of the pose-pose terms.
-  Eigen::VectorXd g_poses_;
   Eigen::MatrixXd S_;  // The damped reduced system (lower triangle), then its Cholesky factor.
   Eigen::VectorXd pose_step_;
 };
@@ -640,7 +672,7 @@ std::string timingReport(const Outcome& outcome) {
      << " iterations (dense kernels: " << dense::kernelVariant() << ")\n"
      << "Successful steps " << iterations - rejected + 1 << " (the start counts as one)\n"
      << "Unsuccessful steps " << rejected << "\n"
-     << "  Residual only evaluation " << timings.cost << "\n"
+     << "  Residual only evaluation 0 (each trial step is linearised)\n"
      << "  Jacobian & residual evaluation " << timings.linearize << "\n"
      << "  Linear solver " << timings.eliminate + timings.reduced + timings.back_substitute << "\n"
      << "    groups eliminated " << timings.eliminate << ", reduced system " << timings.reduced
@@ -659,7 +691,8 @@ Outcome minimise(GraphSchurProblem* problem, std::vector<double>* x,
     *seconds += secondsSince(clock);
     return result;
   };
-  double cost = timed(&out.timings.linearize, [&] { return problem->evaluate(*x, true); });
+  double cost = timed(&out.timings.linearize, [&] { return problem->linearize(*x); });
+  problem->adoptLinearization();
   out.initial_cost_by_type = problem->costByTypeAtLinearization();
   if (options.on_iteration) options.on_iteration({0, cost, secondsSince(start), false});
   const auto stop = [&out](const char* why) {
@@ -687,7 +720,7 @@ Outcome minimise(GraphSchurProblem* problem, std::vector<double>* x,
     double new_cost = cost;
     if (valid) {
       problem->retract(*x, &candidate);
-      new_cost = timed(&out.timings.cost, [&] { return problem->evaluate(candidate, false); });
+      new_cost = timed(&out.timings.linearize, [&] { return problem->linearize(candidate); });
     }
     const double change = cost - new_cost;
     if (valid && std::abs(change) <= options.function_tolerance * cost) {
@@ -699,7 +732,8 @@ Outcome minimise(GraphSchurProblem* problem, std::vector<double>* x,
         valid && std::isfinite(new_cost) && change > kMinRelativeDecrease * model_decrease;
     if (kept) {
       x->swap(candidate);
-      cost = timed(&out.timings.linearize, [&] { return problem->evaluate(*x, true); });
+      problem->adoptLinearization();
+      cost = new_cost;
       radius.accept(change / model_decrease);
       if (problem->gradientMaxNorm() <= options.gradient_tolerance) {
         stop("Gradient tolerance reached.");

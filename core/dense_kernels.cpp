@@ -40,6 +40,10 @@ void subtractProductTransposed(MatrixSpan c, MatrixSpan a, MatrixSpan b) {
 
 void subtractGramLower(MatrixSpan c, MatrixSpan a) { CURVESFM_DISPATCH(subtractGramLower(c, a)); }
 
+void productTransposedFloat(const float* a, long m, const float* b, long n, long k, float* c) {
+  CURVESFM_DISPATCH(productTransposedFloat(a, m, b, n, k, c));
+}
+
 bool avx2KernelsRun() { return useAvx2(); }
 
 const char* kernelVariant() { return useAvx2() ? "avx2" : "baseline"; }

@@ -1,7 +1,8 @@
 #pragma once
 
-// The dense products and factorisations of our own Schur complement (graph/schur_solver.cpp)
-// and of parallelCholesky, compiled twice: for the build's baseline (SSE2 on x86-64) and, where
+// The dense products and factorisations of our own Schur complement (graph/schur_solver.cpp),
+// of parallelCholesky and of descriptor matching (frontend/image/feature_matching.cpp), compiled
+// twice: for the build's baseline (SSE2 on x86-64) and, where
 // the compiler can, with AVX2 and FMA, chosen once at run time by what the CPU supports. Eigen
 // picks its SIMD at compile time, so the AVX2 copy lives in its own translation unit with Eigen
 // in a namespace of its own (dense_kernels_avx2.cpp says why). This header holds no Eigen
@@ -40,6 +41,10 @@ void subtractProductTransposed(MatrixSpan c, MatrixSpan a, MatrixSpan b);
 /// The lower triangle of c <- c - a a^T (c square; its strict upper triangle is left alone).
 void subtractGramLower(MatrixSpan c, MatrixSpan a);
 
+/// c = a b^T for row-major single-precision matrices without gaps between rows: a is m x k, b
+/// n x k, c m x n (the dot products of two descriptor sets).
+void productTransposedFloat(const float* a, long m, const float* b, long n, long k, float* c);
+
 /// Whether the calls above run the avx2 copy.
 bool avx2KernelsRun();
 
@@ -48,11 +53,12 @@ const char* kernelVariant();
 
 // The two copies, for the dispatch and the tests; the avx2 one exists where the build defines
 // CURVESFM_DENSE_AVX2, and runs only on a CPU with AVX2 and FMA.
-#define CURVESFM_DENSE_KERNELS_OF_ONE_COPY                                   \
-  bool factorLower(MatrixSpan a);                                            \
-  void solveLowerTransposedRight(MatrixSpan l, MatrixSpan b);                \
+#define CURVESFM_DENSE_KERNELS_OF_ONE_COPY                                  \
+  bool factorLower(MatrixSpan a);                                           \
+  void solveLowerTransposedRight(MatrixSpan l, MatrixSpan b);               \
   void subtractProductTransposed(MatrixSpan c, MatrixSpan a, MatrixSpan b); \
-  void subtractGramLower(MatrixSpan c, MatrixSpan a);
+  void subtractGramLower(MatrixSpan c, MatrixSpan a);                       \
+  void productTransposedFloat(const float* a, long m, const float* b, long n, long k, float* c);
 namespace baseline {
 CURVESFM_DENSE_KERNELS_OF_ONE_COPY
 }

@@ -33,6 +33,12 @@ void subtractGramLower(MatrixSpan c, MatrixSpan a) {
   view(c).selfadjointView<Eigen::Lower>().rankUpdate(view(a), -1.0);
 }
 
+void productTransposedFloat(const float* a, long m, const float* b, long n, long k, float* c) {
+  using RowMajor = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  Eigen::Map<RowMajor>(c, m, n).noalias() =
+      Eigen::Map<const RowMajor>(a, m, k) * Eigen::Map<const RowMajor>(b, n, k).transpose();
+}
+
 }  // namespace CURVESFM_DENSE_VARIANT
 }  // namespace dense
 }  // namespace curvesfm

@@ -83,5 +83,28 @@ TEST(DenseKernels, EveryCopyRefusesAMatrixThatIsNotPositiveDefinite) {
   }
 }
 
+// Whole numbers up to 255 in 128 columns, as OpenCV's SIFT descriptors: every dot product is an
+// integer below 2^24, so each copy must give it exactly, as BLAS did (feature_matching.cpp relies
+// on it for distances that do not depend on the copy).
+TEST(DenseKernels, EveryCopyGivesExactDotProductsOfWholeNumberDescriptors) {
+  using FloatRows = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const FloatRows a = (FloatRows::Random(37, 128).array() * 127.5f + 127.5f).round().matrix();
+  const FloatRows b = (FloatRows::Random(53, 128).array() * 127.5f + 127.5f).round().matrix();
+  const Eigen::MatrixXd expected = a.cast<double>() * b.cast<double>().transpose();
+  const std::vector<std::pair<std::string, decltype(&dense::productTransposedFloat)>> products = {
+    {"dispatch", dense::productTransposedFloat},
+    {"baseline", dense::baseline::productTransposedFloat},
+#if defined(CURVESFM_DENSE_AVX2)
+    {"avx2", dense::avx2KernelsRun() ? dense::avx2::productTransposedFloat
+                                     : dense::baseline::productTransposedFloat},
+#endif
+  };
+  for (const auto& [name, product] : products) {
+    FloatRows c(37, 53);
+    product(a.data(), 37, b.data(), 53, 128, c.data());
+    EXPECT_EQ(c.cast<double>(), expected) << name;
+  }
+}
+
 }  // namespace
 }  // namespace curvesfm

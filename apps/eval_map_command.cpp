@@ -1,6 +1,7 @@
 #include "apps/eval_map_command.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -15,6 +16,8 @@
 #include "core/dataset_io.h"
 #include "core/errors.h"
 #include "core/median.h"
+#include "core/tum_dataset.h"
+#include "frontend/image/image_undistorter.h"
 
 namespace curvesfm {
 namespace {
@@ -93,6 +96,63 @@ double alignByCameraFrames(const std::vector<StampedPose>& trajectory,
   return axis_length;
 }
 
+// The ground truth cut into parts no longer than `spacing`: each part as a two-point polyline,
+// with its midpoint and length.
+struct CurveParts {
+  Polylines3 pieces;
+  std::vector<Eigen::Vector3d> midpoints;
+  std::vector<Eigen::Vector3d> directions;  // Unit; any unit vector for a part of no length.
+  std::vector<double> lengths;
+};
+
+CurveParts cutIntoParts(const Polylines3& curves, double spacing) {
+  CurveParts parts;
+  for (const auto& polyline : curves) {
+    for (std::size_t i = 0; i + 1 < polyline.size(); ++i) {
+      const Eigen::Vector3d& a = polyline[i];
+      const Eigen::Vector3d& b = polyline[i + 1];
+      const double length = (b - a).norm();
+      const int n = std::max(1, static_cast<int>(std::ceil(length / spacing)));
+      for (int k = 0; k < n; ++k) {
+        const Eigen::Vector3d start = a + (b - a) * (static_cast<double>(k) / n);
+        const Eigen::Vector3d end = a + (b - a) * (static_cast<double>(k + 1) / n);
+        parts.pieces.push_back({start, end});
+        parts.midpoints.push_back(0.5 * (start + end));
+        parts.directions.push_back(length > 0.0 ? Eigen::Vector3d((b - a) / length)
+                                                : Eigen::Vector3d::UnitX());
+        parts.lengths.push_back(length / n);
+      }
+    }
+  }
+  return parts;
+}
+
+nlohmann::json recallsToJson(const CurveMapEvaluation& e) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const CurveMapScore& s : e.scores) out.push_back({{"tau", s.tau}, {"recall", s.recall}});
+  return out;
+}
+
+// One figure of every score, " / " between them.
+template <typename Figure>
+std::string scoresText(const CurveMapEvaluation& e, const char* format, Figure figure) {
+  std::string text;
+  for (const CurveMapScore& s : e.scores) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof(buffer), format, figure(s));
+    text += (text.empty() ? "" : " / ") + std::string(buffer);
+  }
+  return text;
+}
+
+std::string tausText(const CurveMapEvaluation& e) {
+  return scoresText(e, "%g", [](const CurveMapScore& s) { return s.tau; });
+}
+
+std::string recallsText(const CurveMapEvaluation& e) {
+  return scoresText(e, "%.3f", [](const CurveMapScore& s) { return s.recall; });
+}
+
 }  // namespace
 
 EvalMapCommand::EvalMapCommand(CLI::App* app) {
@@ -132,7 +192,97 @@ EvalMapCommand::EvalMapCommand(CLI::App* app) {
                 "instead of the centres alone, whose fit leaves the rotation about a straight "
                 "trajectory's line free")
       ->capture_default_str();
+  c->add_option(
+       "--edge-coverage", edge_coverage_,
+       "Also project the ground-truth curves into every image of --dataset at its "
+       "ground-truth pose and report the share of their length that lies on an image edge "
+       "(run's default Canny) in at least --edge-coverage-min-views images, and the recall "
+       "on that part and on the rest: how much of the ground truth an edge-based map could "
+       "hold at all (occlusion is not modelled, so an upper bound)")
+      ->capture_default_str();
+  c->add_option("--edge-coverage-min-views", edge_coverage_min_views_,
+                "Views on an edge that make a ground-truth point visible as an edge (two: the "
+                "least a triangulation needs)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100000));
+  c->add_option("--edge-coverage-min-share", edge_coverage_min_share_,
+                "... and on an edge in at least this share of the images it lies in (a point of "
+                "a textured region falls near some edge of its direction in a few by chance)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  c->add_option("--edge-coverage-distance", edge_coverage_options_.max_edge_distance_px,
+                "A ground-truth point is on an edge in an image when an edge pixel's centre lies "
+                "within this distance of the pixel its projection falls in (px) ...")
+      ->capture_default_str();
+  c->add_option("--edge-coverage-normal-angle", edge_coverage_options_.max_normal_angle_deg,
+                "... and that pixel's edge normal within this angle of the projected curve's "
+                "normal (deg)")
+      ->capture_default_str();
   c->add_option("--json", json_path_, "Write every figure, the alignment and the options as JSON");
+}
+
+nlohmann::json EvalMapCommand::reportEdgeCoverage(const Polylines3& estimate,
+                                                  const Polylines3& ground_truth,
+                                                  double spacing) const {
+  const ImageSequence sequence = loadImageSequence(dataset_dir_, sequence_);
+  if (sequence.ground_truth.empty()) {
+    throw IoError(dataset_dir_,
+                  "has no ground-truth trajectory to project the ground-truth curves with "
+                  "(--edge-coverage)");
+  }
+  const std::vector<DatasetFrame> frames = framesWithPoses(
+      sequence, sequence.ground_truth, alignment_.max_dt, sequence.ground_truth_source);
+  const ImageUndistorter undistorter(sequence.camera);
+  const CurveParts parts = cutIntoParts(ground_truth, spacing);
+  EdgeCoverageCounter counter(parts.midpoints, parts.directions, edge_coverage_options_);
+  for (const DatasetFrame& frame : frames) {
+    counter.addView(undistorter.undistort(loadFrameImage(frame, sequence.camera)),
+                    frame.initial_cam_from_world, undistorter.camera());
+  }
+  // Shown as an edge: on an edge in at least min_views images and in at least min_share of the
+  // images it projects into (a point of a textured region falls near some edge of its direction
+  // in a few views by chance).
+  const int min_views = edge_coverage_min_views_;
+  const double min_share = edge_coverage_min_share_;
+  double total = 0.0, in_views = 0.0, on_edge = 0.0, shown_length = 0.0;
+  Polylines3 shown, not_shown;
+  for (std::size_t i = 0; i < parts.lengths.size(); ++i) {
+    const PointViews& views = counter.views()[i];
+    const double length = parts.lengths[i];
+    total += length;
+    if (views.in_image >= min_views) in_views += length;
+    if (views.on_edge >= min_views) on_edge += length;
+    if (views.on_edge >= min_views && views.on_edge >= min_share * views.in_image) {
+      shown_length += length;
+      shown.push_back(parts.pieces[i]);
+    } else {
+      not_shown.push_back(parts.pieces[i]);
+    }
+  }
+  const auto share = [total](double length) { return total > 0.0 ? length / total : 0.0; };
+  const CurveMapEvaluation on_shown = evaluateCurveMap(estimate, shown, options_);
+  const CurveMapEvaluation on_rest = evaluateCurveMap(estimate, not_shown, options_);
+  std::printf(
+      "edge coverage (%d images of %s at their ground-truth poses; an edge pixel within %g px, "
+      "its normal within %g deg of the curve's): of the ground truth's length %.3f lies in >= %d "
+      "images, %.3f on an edge in >= %d, %.3f shown as an edge (in >= %d images and >= %g of "
+      "those it lies in; occlusion not modelled: upper bounds)\n",
+      counter.numViews(), dataset_dir_.c_str(), edge_coverage_options_.max_edge_distance_px,
+      edge_coverage_options_.max_normal_angle_deg, share(in_views), min_views, share(on_edge),
+      min_views, share(shown_length), min_views, min_share);
+  std::printf("  recall at tau %s on the part shown as an edge: %s; on the rest: %s\n",
+              tausText(on_shown).c_str(), recallsText(on_shown).c_str(),
+              recallsText(on_rest).c_str());
+  return {{"images", counter.numViews()},
+          {"min_views", min_views},
+          {"min_share", min_share},
+          {"max_edge_distance_px", edge_coverage_options_.max_edge_distance_px},
+          {"max_normal_angle_deg", edge_coverage_options_.max_normal_angle_deg},
+          {"share_in_min_views", share(in_views)},
+          {"share_on_edge_in_min_views", share(on_edge)},
+          {"share_shown", share(shown_length)},
+          {"recall_on_shown_part", recallsToJson(on_shown)},
+          {"recall_elsewhere", recallsToJson(on_rest)}};
 }
 
 std::string EvalMapCommand::curvesPath() const {
@@ -149,6 +299,12 @@ void EvalMapCommand::validate() const {
   table_.validate();
   if (run_dir_.empty() && curves_path_.empty()) {
     throw CLI::ValidationError("eval-map", "give --run RUN_DIR or --curves FILE");
+  }
+  edge_coverage_options_.validate();
+  if (edge_coverage_ && dataset_dir_.empty()) {
+    throw CLI::ValidationError("eval-map",
+                               "--edge-coverage needs the images and ground-truth poses: give "
+                               "--dataset");
   }
   if (alignment_.alignment == AlignmentKind::kNone) return;
   if (run_dir_.empty() && trajectory_path_.empty()) {
@@ -238,6 +394,9 @@ int EvalMapCommand::run() const {
       "units)\n",
       e.sample_spacing);
   printScores(e);
+  const nlohmann::json edge_coverage =
+      edge_coverage_ ? reportEdgeCoverage(estimate, ground_truth, 10.0 * e.sample_spacing)
+                     : nlohmann::json(nullptr);
 
   if (!json_path_.empty()) {
     nlohmann::json report = evaluationToJson(e);
@@ -249,6 +408,7 @@ int EvalMapCommand::run() const {
         {"curves", curves_path},
         {"ground_truth_curves", ground_truth_curves_path_},
         {"ground_truth_format", toString(detectCurveMapFormat(ground_truth_curves_path_))}};
+    report["edge_coverage"] = edge_coverage;
     report["alignment"] = nullptr;
     if (alignment) {
       report["inputs"]["trajectory"] = trajectoryPath();

@@ -1,12 +1,14 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "apps/cli/options_table.h"
 #include "core/curve_map_evaluation.h"
 #include "core/image_sequence.h"
 #include "core/trajectory_evaluation.h"
+#include "frontend/image/edge_coverage.h"
 
 namespace curvesfm {
 
@@ -16,7 +18,8 @@ namespace curvesfm {
 /// ground truth's frame by the Sim(3) (or SE(3)) that aligns its trajectory onto the ground-truth
 /// trajectory (compareTrajectories, as `eval` does), read from the dataset (loadImageSequence) or a
 /// TUM file; `--align none` takes the curves as they are. Prints a table per tau and writes every
-/// figure and option as JSON.
+/// figure and option as JSON. With `--edge-coverage`, also how much of the ground truth the
+/// dataset's images show as edges (frontend/image/edge_coverage.h) and the recall on that part.
 class EvalMapCommand {
  public:
   explicit EvalMapCommand(CLI::App* app);
@@ -34,6 +37,8 @@ class EvalMapCommand {
  private:
   std::string curvesPath() const;
   std::string trajectoryPath() const;
+  nlohmann::json reportEdgeCoverage(const Polylines3& estimate, const Polylines3& ground_truth,
+                                    double spacing) const;
 
   CLI::App* command_;
   std::string run_dir_;
@@ -44,6 +49,10 @@ class EvalMapCommand {
   std::string ground_truth_curves_path_;
   std::string json_path_;
   bool align_frames_ = true;
+  bool edge_coverage_ = false;
+  int edge_coverage_min_views_ = 2;
+  double edge_coverage_min_share_ = 0.5;
+  EdgeCoverageOptions edge_coverage_options_;
   ImageSequenceOptions sequence_;
   TrajectoryEvaluationOptions alignment_;
   CurveMapEvaluationOptions options_;

@@ -183,6 +183,40 @@ TEST_F(EvalMapCommandTest, MissingInputsAndBadOptionsAreUsageErrors) {
                        path("gt") + " --tau 0.01,x");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("expected comma-separated numbers"));
+  result = runCurvesfm("eval-map --align none --curves " + path("x.obj") + " --gt-curves " +
+                       path("gt") + " --edge-coverage true");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--edge-coverage needs the images"));
+  result = runCurvesfm("eval-map --align none --curves " + path("x.obj") + " --gt-curves " +
+                       path("gt") + " --edge-coverage-normal-angle 100");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("max_normal_angle_deg"));
+}
+
+// The rendered curves of `synth curves`, scored against themselves: all of them lie in the
+// images, most on an edge of their direction, and whatever the split the recall is 1.
+TEST_F(EvalMapCommandTest, EdgeCoverageSplitsTheGroundTruthByWhatTheImagesShow) {
+  const std::string data = path("synth");
+  ASSERT_EQ(
+      runCurvesfm("synth curves --out " + data + " --keyframes 8 --curves 10 --seed 3").exit_code,
+      0);
+  const std::string curves = data + "/gt_curves.obj";
+  const CommandResult result =
+      runCurvesfm("eval-map --curves " + curves + " --gt-curves " + curves + " --dataset " + data +
+                  " --align none --edge-coverage true --json " + path("map.json"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("edge coverage (8 images of"));
+  EXPECT_THAT(result.output, HasSubstr("on the part shown as an edge: 1.000 / 1.000 / 1.000"));
+  const nlohmann::json coverage = readJson("map.json")["edge_coverage"];
+  EXPECT_EQ(coverage["images"], 8);
+  EXPECT_EQ(coverage["min_views"], 2);
+  const double in_views = coverage["share_in_min_views"].get<double>();
+  const double on_edge = coverage["share_on_edge_in_min_views"].get<double>();
+  const double shown = coverage["share_shown"].get<double>();
+  EXPECT_LE(in_views, 1.0);
+  EXPECT_LE(on_edge, in_views);
+  EXPECT_LE(shown, on_edge);
+  EXPECT_GT(shown, 0.3);
 }
 
 TEST_F(EvalMapCommandTest, BadFilesExitWithOneLineNamingFileAndLine) {

@@ -1,0 +1,65 @@
+#include "frontend/image/edge_coverage.h"
+
+#include <cmath>
+
+#include "core/check.h"
+#include "core/errors.h"
+#include "core/nearest_edge_field.h"
+
+namespace curvesfm {
+
+void EdgeCoverageOptions::validate() const {
+  const OptionCheck require("EdgeCoverageOptions");
+  require(max_edge_distance_px > 0.0 && max_edge_distance_px <= 100.0, "max_edge_distance_px",
+          max_edge_distance_px, "in (0, 100]");
+  require(max_normal_angle_deg > 0.0 && max_normal_angle_deg <= 90.0, "max_normal_angle_deg",
+          max_normal_angle_deg, "in (0, 90]");
+  edges.validate();
+}
+
+EdgeCoverageCounter::EdgeCoverageCounter(std::vector<Eigen::Vector3d> points,
+                                         std::vector<Eigen::Vector3d> directions,
+                                         const EdgeCoverageOptions& options)
+    : points_(std::move(points)),
+      directions_(std::move(directions)),
+      options_(options),
+      views_(points_.size()) {
+  options_.validate();
+  CURVESFM_CHECK(points_.size() == directions_.size())
+      << "edge coverage: " << points_.size() << " points, " << directions_.size() << " directions";
+}
+
+void EdgeCoverageCounter::addView(const cv::Mat& image, const Pose3& cam_from_world,
+                                  const Camera& camera) {
+  CURVESFM_CHECK(image.cols == camera.width() && image.rows == camera.height())
+      << "edge coverage: a " << image.cols << "x" << image.rows << " image for a "
+      << camera.width() << "x" << camera.height() << " camera";
+  const EdgeImage edges = detectEdges(image, options_.edges);
+  NearestEdgeFieldOptions reach;
+  reach.max_distance_px = static_cast<int>(std::ceil(options_.max_edge_distance_px));
+  const NearestEdgeField field =
+      NearestEdgeField::build(edges.edges, edges.grad_x, edges.grad_y, reach);
+  const double sin_max_angle = std::sin(options_.max_normal_angle_deg * M_PI / 180.0);
+  const Eigen::Matrix3d R = cam_from_world.rotationMatrix();
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    Eigen::Vector2d pixel;
+    Matrix23d d_pixel;
+    if (!camera.project(cam_from_world * points_[i], &pixel, &d_pixel)) continue;
+    if (!field.contains(pixel.x(), pixel.y())) continue;
+    ++views_[i].in_image;
+    const EdgePixel* edge = field.nearest(pixel.x(), pixel.y());
+    if (!edge) continue;
+    const Eigen::Vector2d nearest_centre(std::round(pixel.x()), std::round(pixel.y()));
+    if ((edge->pixel.cast<double>() - nearest_centre).norm() > options_.max_edge_distance_px) {
+      continue;
+    }
+    // The edge normal must be nearly normal to the projected curve: |n . t| <= sin(angle) |t|.
+    const Eigen::Vector2d tangent = d_pixel * (R * directions_[i]);
+    if (std::abs(edge->normal.cast<double>().dot(tangent)) <= sin_max_angle * tangent.norm()) {
+      ++views_[i].on_edge;
+    }
+  }
+  ++num_views_;
+}
+
+}  // namespace curvesfm

@@ -185,6 +185,8 @@ EvalMapCommand::EvalMapCommand(CLI::App* app) {
   addTrajectoryEvaluationOptions(&table_, &alignment_,
                                  {"/alignment", "", "Trajectory alignment", ""});
   addCurveMapEvaluationOptions(&table_, &options_, {"/curve_map", "", "Curve map", ""});
+  addEdgeCoverageOptions(&table_, &edge_coverage_options_,
+                         {"/edge_coverage", "edge-coverage-", "Edge coverage", ""});
   table_.addFlags(c);
   c->add_option("--align-frames", align_frames_,
                 "With --align sim3, fit the alignment to the camera frames (each centre and the "
@@ -210,14 +212,6 @@ EvalMapCommand::EvalMapCommand(CLI::App* app) {
                 "a textured region falls near some edge of its direction in a few by chance)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  c->add_option("--edge-coverage-distance", edge_coverage_options_.max_edge_distance_px,
-                "A ground-truth point is on an edge in an image when an edge pixel's centre lies "
-                "within this distance of the pixel its projection falls in (px) ...")
-      ->capture_default_str();
-  c->add_option("--edge-coverage-normal-angle", edge_coverage_options_.max_normal_angle_deg,
-                "... and that pixel's edge normal within this angle of the projected curve's "
-                "normal (deg)")
-      ->capture_default_str();
   c->add_option("--json", json_path_, "Write every figure, the alignment and the options as JSON");
 }
 
@@ -300,7 +294,6 @@ void EvalMapCommand::validate() const {
   if (run_dir_.empty() && curves_path_.empty()) {
     throw CLI::ValidationError("eval-map", "give --run RUN_DIR or --curves FILE");
   }
-  edge_coverage_options_.validate();
   if (edge_coverage_ && dataset_dir_.empty()) {
     throw CLI::ValidationError("eval-map",
                                "--edge-coverage needs the images and ground-truth poses: give "

@@ -71,9 +71,25 @@ void addImageStages(OptionsTable* table, PipelineOptions* o, const std::string& 
   table->group(&o->undistort, "ImageUndistorterOptions", u.path, u.prefix, u.heading)
       .number("valid_margin_px", "valid-margin", &o->undistort.valid_margin_px,
               "Band along the border of the undistorted data ignored by edge detection (px)");
-  EdgeDetectorOptions* e = &o->edges;
-  OptionPlace edges = stage(path, "edges", "edges-", "Edges");
-  table->group(e, "EdgeDetectorOptions", edges.path, edges.prefix, edges.heading)
+  addEdgeDetectorOptions(table, &o->edges, stage(path, "edges", "edges-", "Edges"));
+  OptionPlace c = stage(path, "chains", "chains-", "Chains");
+  table->group(&o->chains, "EdgeChainOptions", c.path, c.prefix, c.heading)
+      .number("min_length_px", "min-length", &o->chains.min_length_px,
+              "Chains with fewer pixels are dropped (px)")
+      .number("max_turn_deg", "max-turn", &o->chains.max_turn_deg,
+              "Split a chain where it turns by more than this over the turn window (deg)")
+      .number("turn_window_px", "turn-window", &o->chains.turn_window_px,
+              "Window of the turn measure (chain pixels)");
+  OptionPlace f = stage(path, "field", "field-", "Nearest-edge field");
+  table->group(&o->field, "NearestEdgeFieldOptions", f.path, f.prefix, f.heading)
+      .number("max_distance_px", "max-distance", &o->field.max_distance_px,
+              "Reach of the nearest-edge field (px)");
+}
+
+}  // namespace
+
+void addEdgeDetectorOptions(OptionsTable* table, EdgeDetectorOptions* e, const OptionPlace& place) {
+  table->group(e, "EdgeDetectorOptions", place.path, place.prefix, place.heading)
       .number("blur_sigma_px", "blur-sigma", &e->blur_sigma_px,
               "Gaussian blur before differentiation (px); 0 disables it")
       .number("sobel_aperture", "sobel-aperture", &e->sobel_aperture, "Sobel aperture: 3 or 5")
@@ -89,19 +105,23 @@ void addImageStages(OptionsTable* table, PipelineOptions* o, const std::string& 
               "Floor of the automatic high threshold (grey levels/px)")
       .number("auto_low_ratio", "auto-low-ratio", &e->auto_low_ratio,
               "Automatic low threshold as a fraction of the high one");
-  OptionPlace c = stage(path, "chains", "chains-", "Chains");
-  table->group(&o->chains, "EdgeChainOptions", c.path, c.prefix, c.heading)
-      .number("min_length_px", "min-length", &o->chains.min_length_px,
-              "Chains with fewer pixels are dropped (px)")
-      .number("max_turn_deg", "max-turn", &o->chains.max_turn_deg,
-              "Split a chain where it turns by more than this over the turn window (deg)")
-      .number("turn_window_px", "turn-window", &o->chains.turn_window_px,
-              "Window of the turn measure (chain pixels)");
-  OptionPlace f = stage(path, "field", "field-", "Nearest-edge field");
-  table->group(&o->field, "NearestEdgeFieldOptions", f.path, f.prefix, f.heading)
-      .number("max_distance_px", "max-distance", &o->field.max_distance_px,
-              "Reach of the nearest-edge field (px)");
 }
+
+void addEdgeCoverageOptions(OptionsTable* table, EdgeCoverageOptions* o, const OptionPlace& place) {
+  table->group(o, "EdgeCoverageOptions", place.path, place.prefix, place.heading)
+      .number("max_edge_distance_px", "distance", &o->max_edge_distance_px,
+              "A ground-truth point is on an edge in an image when an edge pixel's centre lies "
+              "within this distance of the pixel its projection falls in (px) ...")
+      .number("max_normal_angle_deg", "normal-angle", &o->max_normal_angle_deg,
+              "... and that pixel's edge normal within this angle of the projected curve's "
+              "normal (deg)")
+      .nested("edges");
+  OptionPlace edges = place.child("edges");
+  edges.prefix += "edges-";
+  addEdgeDetectorOptions(table, &o->edges, edges);
+}
+
+namespace {
 
 void addDepth(OptionsTable* table, EpipolarDepthOptions* d, const std::string& path) {
   const OptionPlace p = stage(path, "depth", "depth-", "Depth");

@@ -11,6 +11,7 @@
 #include "factors/curve_bundle_adjustment.h"
 #include "factors/point_bundle_adjustment.h"
 #include "frontend/image/curve_overlay.h"
+#include "frontend/image/edge_coverage.h"
 #include "frontend/image/feature_matching.h"
 #include "frontend/image/point_tracks.h"
 #include "frontend/image/two_view_geometry.h"
@@ -89,6 +90,12 @@ void addTwoViewOptions(OptionsTable* table, TwoViewOptions* options, const Optio
 void addTrajectoryEvaluationOptions(OptionsTable* table, TrajectoryEvaluationOptions* options,
                                     const OptionPlace& place);
 /// taus is one comma-separated flag value, e.g. `--tau 0.01,0.02,0.05`.
+/// The pipeline's Canny (`--edges-*` in run, under `place.prefix` elsewhere).
+void addEdgeDetectorOptions(OptionsTable* table, EdgeDetectorOptions* options,
+                            const OptionPlace& place);
+/// eval-map's edge coverage of the ground truth (`--edge-coverage-*`).
+void addEdgeCoverageOptions(OptionsTable* table, EdgeCoverageOptions* options,
+                            const OptionPlace& place);
 void addCurveMapEvaluationOptions(OptionsTable* table, CurveMapEvaluationOptions* options,
                                   const OptionPlace& place);
 

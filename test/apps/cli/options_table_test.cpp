@@ -35,6 +35,7 @@ struct AllOptions {
   PlanarSceneOptions planar;
   TrajectoryEvaluationOptions evaluation;
   CurveMapEvaluationOptions curve_map;
+  EdgeCoverageOptions edge_coverage;
 };
 
 // The tables as the commands build them (run, curve-ba, point-ba, synth planar, eval, eval-map);
@@ -60,6 +61,8 @@ std::vector<OptionsTable> commandTables(AllOptions* o) {
   addTrajectoryEvaluationOptions(&tables[5], &o->evaluation,
                                  {"/alignment", "", "Trajectory alignment", ""});
   addCurveMapEvaluationOptions(&tables[5], &o->curve_map, {"/curve_map", "", "Curve map", ""});
+  addEdgeCoverageOptions(&tables[5], &o->edge_coverage,
+                         {"/edge_coverage", "edge-coverage-", "Edge coverage", ""});
   return tables;
 }
 

@@ -229,33 +229,46 @@ nlohmann::json EvalMapCommand::reportEdgeCoverage(const Polylines3& estimate,
   const ImageUndistorter undistorter(sequence.camera);
   const CurveParts parts = cutIntoParts(ground_truth, spacing);
   EdgeCoverageCounter counter(parts.midpoints, parts.directions, edge_coverage_options_);
+  counter.setNearbyCurves(estimate);
   for (const DatasetFrame& frame : frames) {
     counter.addView(undistorter.undistort(loadFrameImage(frame, sequence.camera)),
                     frame.initial_cam_from_world, undistorter.camera());
   }
   // Shown as an edge: on an edge in at least min_views images and in at least min_share of the
   // images it projects into (a point of a textured region falls near some edge of its direction
-  // in a few views by chance).
+  // in a few views by chance). Of that part, the map has a curve there in the images by the same
+  // count of views, whatever that curve's depth.
   const int min_views = edge_coverage_min_views_;
   const double min_share = edge_coverage_min_share_;
-  double total = 0.0, in_views = 0.0, on_edge = 0.0, shown_length = 0.0;
-  Polylines3 shown, not_shown;
+  const auto enough = [&](int views, int in_image) {
+    return views >= min_views && views >= min_share * in_image;
+  };
+  double total = 0.0, in_views = 0.0, on_edge = 0.0, shown_length = 0.0, mapped_length = 0.0;
+  Polylines3 shown, not_shown, shown_mapped, shown_unmapped;
   for (std::size_t i = 0; i < parts.lengths.size(); ++i) {
     const PointViews& views = counter.views()[i];
     const double length = parts.lengths[i];
     total += length;
     if (views.in_image >= min_views) in_views += length;
     if (views.on_edge >= min_views) on_edge += length;
-    if (views.on_edge >= min_views && views.on_edge >= min_share * views.in_image) {
-      shown_length += length;
-      shown.push_back(parts.pieces[i]);
-    } else {
+    if (!enough(views.on_edge, views.in_image)) {
       not_shown.push_back(parts.pieces[i]);
+      continue;
+    }
+    shown_length += length;
+    shown.push_back(parts.pieces[i]);
+    if (enough(views.near_curve, views.in_image)) {
+      mapped_length += length;
+      shown_mapped.push_back(parts.pieces[i]);
+    } else {
+      shown_unmapped.push_back(parts.pieces[i]);
     }
   }
   const auto share = [total](double length) { return total > 0.0 ? length / total : 0.0; };
   const CurveMapEvaluation on_shown = evaluateCurveMap(estimate, shown, options_);
   const CurveMapEvaluation on_rest = evaluateCurveMap(estimate, not_shown, options_);
+  const CurveMapEvaluation on_mapped = evaluateCurveMap(estimate, shown_mapped, options_);
+  const CurveMapEvaluation on_unmapped = evaluateCurveMap(estimate, shown_unmapped, options_);
   std::printf(
       "edge coverage (%d images of %s at their ground-truth poses; an edge pixel within %g px, "
       "its normal within %g deg of the curve's): of the ground truth's length %.3f lies in >= %d "
@@ -267,6 +280,11 @@ nlohmann::json EvalMapCommand::reportEdgeCoverage(const Polylines3& estimate,
   std::printf("  recall at tau %s on the part shown as an edge: %s; on the rest: %s\n",
               tausText(on_shown).c_str(), recallsText(on_shown).c_str(),
               recallsText(on_rest).c_str());
+  std::printf(
+      "  of the part shown as an edge, %.3f of the ground truth's length has a curve of the map "
+      "within %g px in the images (as many of them; any depth): recall there %s, elsewhere %s\n",
+      share(mapped_length), edge_coverage_options_.max_edge_distance_px,
+      recallsText(on_mapped).c_str(), recallsText(on_unmapped).c_str());
   return {{"images", counter.numViews()},
           {"min_views", min_views},
           {"min_share", min_share},
@@ -275,8 +293,11 @@ nlohmann::json EvalMapCommand::reportEdgeCoverage(const Polylines3& estimate,
           {"share_in_min_views", share(in_views)},
           {"share_on_edge_in_min_views", share(on_edge)},
           {"share_shown", share(shown_length)},
+          {"share_shown_with_a_curve_in_the_images", share(mapped_length)},
           {"recall_on_shown_part", recallsToJson(on_shown)},
-          {"recall_elsewhere", recallsToJson(on_rest)}};
+          {"recall_elsewhere", recallsToJson(on_rest)},
+          {"recall_on_shown_part_with_a_curve_in_the_images", recallsToJson(on_mapped)},
+          {"recall_on_shown_part_without", recallsToJson(on_unmapped)}};
 }
 
 std::string EvalMapCommand::curvesPath() const {

@@ -1,6 +1,7 @@
 #include "frontend/image/edge_coverage.h"
 
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 
 #include "core/check.h"
 #include "core/errors.h"
@@ -29,6 +30,41 @@ EdgeCoverageCounter::EdgeCoverageCounter(std::vector<Eigen::Vector3d> points,
       << "edge coverage: " << points_.size() << " points, " << directions_.size() << " directions";
 }
 
+namespace {
+
+// Distance of every pixel centre to the nearest pixel the curves' projections cross (px); +inf
+// everywhere without curves.
+cv::Mat distanceToCurves(const Polylines3& curves, const Pose3& cam_from_world,
+                         const Camera& camera) {
+  constexpr int kShift = 4;  // Sub-pixel bits of cv::line.
+  cv::Mat crossed(camera.height(), camera.width(), CV_8UC1, cv::Scalar(0));
+  bool any = false;
+  for (const auto& polyline : curves) {
+    for (std::size_t i = 0; i + 1 < polyline.size(); ++i) {
+      Eigen::Vector2d a, b;
+      if (!camera.project(cam_from_world * polyline[i], &a) ||
+          !camera.project(cam_from_world * polyline[i + 1], &b)) {
+        continue;
+      }
+      // Far outside the image a segment is not drawn: cv::line's fixed point would overflow.
+      const double limit = 4.0 * (camera.width() + camera.height());
+      if (a.cwiseAbs().maxCoeff() > limit || b.cwiseAbs().maxCoeff() > limit) continue;
+      const auto fixed = [](const Eigen::Vector2d& p) {
+        return cv::Point(static_cast<int>(std::lround(p.x() * (1 << kShift))),
+                         static_cast<int>(std::lround(p.y() * (1 << kShift))));
+      };
+      cv::line(crossed, fixed(a), fixed(b), cv::Scalar(255), 1, cv::LINE_8, kShift);
+      any = true;
+    }
+  }
+  cv::Mat distance;
+  if (!any) return cv::Mat(crossed.size(), CV_32F, cv::Scalar(INFINITY));
+  cv::distanceTransform(crossed == 0, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  return distance;
+}
+
+}  // namespace
+
 void EdgeCoverageCounter::addView(const cv::Mat& image, const Pose3& cam_from_world,
                                   const Camera& camera) {
   CURVESFM_CHECK(image.cols == camera.width() && image.rows == camera.height())
@@ -41,12 +77,19 @@ void EdgeCoverageCounter::addView(const cv::Mat& image, const Pose3& cam_from_wo
       NearestEdgeField::build(edges.edges, edges.grad_x, edges.grad_y, reach);
   const double sin_max_angle = std::sin(options_.max_normal_angle_deg * M_PI / 180.0);
   const Eigen::Matrix3d R = cam_from_world.rotationMatrix();
+  const cv::Mat curve_distance = distanceToCurves(nearby_curves_, cam_from_world, camera);
   for (std::size_t i = 0; i < points_.size(); ++i) {
     Eigen::Vector2d pixel;
     Matrix23d d_pixel;
     if (!camera.project(cam_from_world * points_[i], &pixel, &d_pixel)) continue;
     if (!field.contains(pixel.x(), pixel.y())) continue;
     ++views_[i].in_image;
+    const int column = static_cast<int>(std::lround(pixel.x()));
+    const int row = static_cast<int>(std::lround(pixel.y()));
+    if (column >= 0 && row >= 0 && column < image.cols && row < image.rows &&
+        curve_distance.at<float>(row, column) <= options_.max_edge_distance_px) {
+      ++views_[i].near_curve;
+    }
     const EdgePixel* edge = field.nearest(pixel.x(), pixel.y());
     if (!edge) continue;
     const Eigen::Vector2d nearest_centre(std::round(pixel.x()), std::round(pixel.y()));

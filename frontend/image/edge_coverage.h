@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/camera.h"
+#include "core/curve_map_io.h"
 #include "core/pose3.h"
 #include "frontend/image/edge_detector.h"
 
@@ -36,6 +37,9 @@ struct EdgeCoverageOptions {
 struct PointViews {
   int in_image = 0;  ///< In front of the camera and inside the image.
   int on_edge = 0;   ///< Of those, the views with an edge of the curve's direction there.
+  /// Of those, the views where one of the nearby curves (setNearbyCurves) projects within
+  /// max_edge_distance_px of it.
+  int near_curve = 0;
 };
 
 /// Counts the views of fixed points, one view at a time (a long sequence need not be in memory).
@@ -50,6 +54,12 @@ class EdgeCoverageCounter {
   /// and its pose. Throws CheckError when the image does not have the camera's size.
   void addView(const cv::Mat& image, const Pose3& cam_from_world, const Camera& camera);
 
+  /// Curves (polylines in the points' world frame, e.g. an estimated map aligned onto the ground
+  /// truth) whose projection the views after this call also look for near each point: where an
+  /// image shows a ground-truth curve as an edge, whether the map has a curve there in the image,
+  /// whatever its depth. Segments with an end behind the camera are left out.
+  void setNearbyCurves(Polylines3 curves) { nearby_curves_ = std::move(curves); }
+
   int numViews() const { return num_views_; }
   const std::vector<PointViews>& views() const { return views_; }
 
@@ -58,6 +68,7 @@ class EdgeCoverageCounter {
   std::vector<Eigen::Vector3d> directions_;
   EdgeCoverageOptions options_;
   std::vector<PointViews> views_;
+  Polylines3 nearby_curves_;
   int num_views_ = 0;
 };
 

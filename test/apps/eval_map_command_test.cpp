@@ -217,6 +217,8 @@ TEST_F(EvalMapCommandTest, EdgeCoverageSplitsTheGroundTruthByWhatTheImagesShow) 
   EXPECT_LE(on_edge, in_views);
   EXPECT_LE(shown, on_edge);
   EXPECT_GT(shown, 0.3);
+  // The map is the ground truth: wherever the images show it, the map has a curve there.
+  EXPECT_DOUBLE_EQ(coverage["share_shown_with_a_curve_in_the_images"].get<double>(), shown);
 }
 
 TEST_F(EvalMapCommandTest, BadFilesExitWithOneLineNamingFileAndLine) {

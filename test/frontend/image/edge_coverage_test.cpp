@@ -37,11 +37,16 @@ TEST(EdgeCoverage, CountsViewsOnAnEdgeOfTheCurvesDirection) {
   const std::vector<Eigen::Vector3d> directions = {up, across, up, up, up};
   EdgeCoverageCounter counter(points, directions, {});
   counter.addView(stepImage(), Pose3(), camera());
+  // From the second view on, a curve along the edge: near the points on it, 50 px from the third.
+  counter.setNearbyCurves({{{-0.005, -0.3, 1.0}, {-0.005, 0.3, 1.0}}});
   counter.addView(stepImage(), Pose3(), camera());
   ASSERT_EQ(counter.numViews(), 2);
   const std::vector<PointViews>& views = counter.views();
   EXPECT_EQ(views[0].in_image, 2);
   EXPECT_EQ(views[0].on_edge, 2);
+  EXPECT_EQ(views[0].near_curve, 1);
+  EXPECT_EQ(views[1].near_curve, 1);
+  EXPECT_EQ(views[2].near_curve, 0);
   EXPECT_EQ(views[1].in_image, 2);
   EXPECT_EQ(views[1].on_edge, 0);
   EXPECT_EQ(views[2].in_image, 2);

@@ -109,8 +109,8 @@ cv::Mat hammingDistances(const cv::Mat& a, const cv::Mat& b) {
 // OpenCV's SIFT descriptors hold whole numbers up to 255, so every dot product and norm is an
 // integer below 2^24 and exact in single precision, whatever the product's order of additions:
 // the AVX2 product of core/dense_kernels.h gives the distances BLAS gave, to the bit, at a third
-// of its time. Squared: square roots keep their order (exact ties aside), so only the two
-// nearest of a row need one.
+// of its time. Squared: square roots keep their order (but where two round to one float), so
+// only the two nearest of a row need one.
 cv::Mat squaredEuclideanDistances(const cv::Mat& a_in, const cv::Mat& b_in) {
   const cv::Mat a = a_in.isContinuous() ? a_in : a_in.clone();
   const cv::Mat b = b_in.isContinuous() ? b_in : b_in.clone();

@@ -197,10 +197,11 @@ EvalMapCommand::EvalMapCommand(CLI::App* app) {
   c->add_option(
        "--edge-coverage", edge_coverage_,
        "Also project the ground-truth curves into every image of --dataset at its "
-       "ground-truth pose and report the share of their length that lies on an image edge "
-       "(run's default Canny) in at least --edge-coverage-min-views images, and the recall "
-       "on that part and on the rest: how much of the ground truth an edge-based map could "
-       "hold at all (occlusion is not modelled, so an upper bound)")
+       "ground-truth pose and report the share of their length the images show as an edge of "
+       "its direction (run's default Canny; in at least --edge-coverage-min-views images and "
+       "--edge-coverage-min-share of those it lies in), whether the map has a curve there in "
+       "the images, and the recall on each part: how much of the ground truth an edge-based "
+       "map could hold at all (occlusion is not modelled, so upper bounds)")
       ->capture_default_str();
   c->add_option("--edge-coverage-min-views", edge_coverage_min_views_,
                 "Views on an edge that make a ground-truth point visible as an edge (two: the "

@@ -218,15 +218,9 @@ EvalMapCommand::EvalMapCommand(CLI::App* app) {
 
 nlohmann::json EvalMapCommand::reportEdgeCoverage(const Polylines3& estimate,
                                                   const Polylines3& ground_truth,
+                                                  const std::vector<DatasetFrame>& frames,
+                                                  const ImageSequence& sequence,
                                                   double spacing) const {
-  const ImageSequence sequence = loadImageSequence(dataset_dir_, sequence_);
-  if (sequence.ground_truth.empty()) {
-    throw IoError(dataset_dir_,
-                  "has no ground-truth trajectory to project the ground-truth curves with "
-                  "(--edge-coverage)");
-  }
-  const std::vector<DatasetFrame> frames = framesWithPoses(
-      sequence, sequence.ground_truth, alignment_.max_dt, sequence.ground_truth_source);
   const ImageUndistorter undistorter(sequence.camera);
   const CurveParts parts = cutIntoParts(ground_truth, spacing);
   EdgeCoverageCounter counter(parts.midpoints, parts.directions, edge_coverage_options_);
@@ -342,24 +336,36 @@ int EvalMapCommand::run() const {
   Polylines3 estimate = readCurveMap(curves_path);
   const Polylines3 ground_truth = readCurveMap(ground_truth_curves_path_);
 
+  const bool align = alignment_.alignment != AlignmentKind::kNone;
+  std::optional<ImageSequence> sequence;
+  if ((align && ground_truth_trajectory_path_.empty()) || edge_coverage_) {
+    sequence = loadImageSequence(dataset_dir_, sequence_);
+    if (sequence->ground_truth.empty()) {
+      throw IoError(dataset_dir_, edge_coverage_
+                                      ? "has no ground-truth trajectory to project the "
+                                        "ground-truth curves with (--edge-coverage)"
+                                      : "has no ground-truth trajectory to align the estimate "
+                                        "with (give --gt-trajectory, or --align none)");
+    }
+  }
+  // The images at their ground-truth poses, for the edge coverage.
+  const std::vector<DatasetFrame> frames =
+      edge_coverage_ ? framesWithPoses(*sequence, sequence->ground_truth, alignment_.max_dt,
+                                       sequence->ground_truth_source)
+                     : std::vector<DatasetFrame>();
+
   std::optional<TrajectoryEvaluation> alignment;
   double frames_axis_length = 0.0;  // > 0: aligned by camera frames, their axes this long.
   std::string ground_truth_source = ground_truth_trajectory_path_;
-  if (alignment_.alignment != AlignmentKind::kNone) {
+  if (align) {
     const std::string trajectory_path = trajectoryPath();
     const std::vector<StampedPose> trajectory = readTrajectory(trajectory_path);
     std::vector<StampedPose> ground_truth_trajectory;
     if (!ground_truth_trajectory_path_.empty()) {
       ground_truth_trajectory = readTrajectory(ground_truth_trajectory_path_);
     } else {
-      const ImageSequence sequence = loadImageSequence(dataset_dir_, sequence_);
-      if (sequence.ground_truth.empty()) {
-        throw IoError(dataset_dir_,
-                      "has no ground-truth trajectory to align the estimate with "
-                      "(give --gt-trajectory, or --align none)");
-      }
-      ground_truth_trajectory = sequence.ground_truth;
-      ground_truth_source = sequence.ground_truth_source;
+      ground_truth_trajectory = sequence->ground_truth;
+      ground_truth_source = sequence->ground_truth_source;
     }
     alignment = compareTrajectories(trajectory, ground_truth_trajectory, alignment_,
                                     trajectory_path, ground_truth_source);
@@ -410,8 +416,9 @@ int EvalMapCommand::run() const {
       e.sample_spacing);
   printScores(e);
   const nlohmann::json edge_coverage =
-      edge_coverage_ ? reportEdgeCoverage(estimate, ground_truth, 10.0 * e.sample_spacing)
-                     : nlohmann::json(nullptr);
+      edge_coverage_
+          ? reportEdgeCoverage(estimate, ground_truth, frames, *sequence, 10.0 * e.sample_spacing)
+          : nlohmann::json(nullptr);
 
   if (!json_path_.empty()) {
     nlohmann::json report = evaluationToJson(e);

@@ -8,6 +8,7 @@
 #include "core/curve_map_evaluation.h"
 #include "core/image_sequence.h"
 #include "core/trajectory_evaluation.h"
+#include "core/tum_dataset.h"
 #include "frontend/image/edge_coverage.h"
 
 namespace curvesfm {
@@ -38,7 +39,8 @@ class EvalMapCommand {
   std::string curvesPath() const;
   std::string trajectoryPath() const;
   nlohmann::json reportEdgeCoverage(const Polylines3& estimate, const Polylines3& ground_truth,
-                                    double spacing) const;
+                                    const std::vector<DatasetFrame>& frames,
+                                    const ImageSequence& sequence, double spacing) const;
 
   CLI::App* command_;
   std::string run_dir_;

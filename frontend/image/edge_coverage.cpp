@@ -1,6 +1,7 @@
 #include "frontend/image/edge_coverage.h"
 
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 
 #include "core/check.h"
@@ -37,6 +38,12 @@ namespace {
 cv::Mat distanceToCurves(const Polylines3& curves, const Pose3& cam_from_world,
                          const Camera& camera) {
   constexpr int kShift = 4;  // Sub-pixel bits of cv::line.
+  const auto fixed = [](const Eigen::Vector2d& p) {
+    return cv::Point(static_cast<int>(std::lround(p.x() * (1 << kShift))),
+                     static_cast<int>(std::lround(p.y() * (1 << kShift))));
+  };
+  // Far outside the image a segment is not drawn: cv::line's fixed point would overflow.
+  const double limit = 4.0 * (camera.width() + camera.height());
   cv::Mat crossed(camera.height(), camera.width(), CV_8UC1, cv::Scalar(0));
   bool any = false;
   for (const auto& polyline : curves) {
@@ -46,19 +53,14 @@ cv::Mat distanceToCurves(const Polylines3& curves, const Pose3& cam_from_world,
           !camera.project(cam_from_world * polyline[i + 1], &b)) {
         continue;
       }
-      // Far outside the image a segment is not drawn: cv::line's fixed point would overflow.
-      const double limit = 4.0 * (camera.width() + camera.height());
       if (a.cwiseAbs().maxCoeff() > limit || b.cwiseAbs().maxCoeff() > limit) continue;
-      const auto fixed = [](const Eigen::Vector2d& p) {
-        return cv::Point(static_cast<int>(std::lround(p.x() * (1 << kShift))),
-                         static_cast<int>(std::lround(p.y() * (1 << kShift))));
-      };
       cv::line(crossed, fixed(a), fixed(b), cv::Scalar(255), 1, cv::LINE_8, kShift);
       any = true;
     }
   }
   cv::Mat distance;
-  if (!any) return cv::Mat(crossed.size(), CV_32F, cv::Scalar(INFINITY));
+  if (!any)
+    return cv::Mat(crossed.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
   cv::distanceTransform(crossed == 0, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
   return distance;
 }
@@ -84,16 +86,15 @@ void EdgeCoverageCounter::addView(const cv::Mat& image, const Pose3& cam_from_wo
     if (!camera.project(cam_from_world * points_[i], &pixel, &d_pixel)) continue;
     if (!field.contains(pixel.x(), pixel.y())) continue;
     ++views_[i].in_image;
-    const int column = static_cast<int>(std::lround(pixel.x()));
-    const int row = static_cast<int>(std::lround(pixel.y()));
-    if (column >= 0 && row >= 0 && column < image.cols && row < image.rows &&
-        curve_distance.at<float>(row, column) <= options_.max_edge_distance_px) {
+    // The pixel whose centre is nearest, as the field rounds (contains() keeps it inside).
+    const int column = static_cast<int>(pixel.x() + 0.5);
+    const int row = static_cast<int>(pixel.y() + 0.5);
+    if (curve_distance.at<float>(row, column) <= options_.max_edge_distance_px) {
       ++views_[i].near_curve;
     }
-    const EdgePixel* edge = field.nearest(pixel.x(), pixel.y());
-    if (!edge) continue;
-    const Eigen::Vector2d nearest_centre(std::round(pixel.x()), std::round(pixel.y()));
-    if ((edge->pixel.cast<double>() - nearest_centre).norm() > options_.max_edge_distance_px) {
+    const EdgePixel* edge = field.nearestToPixel(column, row);
+    if (!edge || (edge->pixel.cast<double>() - Eigen::Vector2d(column, row)).norm() >
+                     options_.max_edge_distance_px) {
       continue;
     }
     // The edge normal must be nearly normal to the projected curve: |n . t| <= sin(angle) |t|.

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -18,6 +19,7 @@ namespace {
 
 using testing::CommandResult;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::runCurvesfm;
 
 // The estimate's frame: x_est = kScale * R^T (x_gt - t), so that aligning its trajectory recovers
@@ -244,6 +246,17 @@ TEST_F(EvalMapCommandTest, BadFilesExitWithOneLineNamingFileAndLine) {
                        " --gt-curves " + path("gt"));
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_THAT(result.output, HasSubstr("TrajectoryEvaluationError: "));
+  // Edge coverage over a dataset without ground-truth poses to project with, before any work.
+  const std::string data = path("synth");
+  ASSERT_EQ(runCurvesfm("synth curves --out " + data + " --keyframes 4 --curves 5").exit_code, 0);
+  std::filesystem::remove(data + "/groundtruth.txt");
+  result =
+      runCurvesfm("eval-map --align none --curves " + path("run/curves.obj") + " --gt-curves " +
+                  path("gt") + " --dataset " + data + " --edge-coverage true");
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.output, HasSubstr("has no ground-truth trajectory to project the "
+                                       "ground-truth curves with (--edge-coverage)"));
+  EXPECT_THAT(result.output, Not(HasSubstr("precision")));
 }
 
 }  // namespace

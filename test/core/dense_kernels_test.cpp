@@ -17,18 +17,20 @@ struct Copy {
   std::function<void(dense::MatrixSpan, dense::MatrixSpan)> solve;
   std::function<void(dense::MatrixSpan, dense::MatrixSpan, dense::MatrixSpan)> product;
   std::function<void(dense::MatrixSpan, dense::MatrixSpan)> gram;
+  std::function<void(const float*, long, const float*, long, long, float*)> product_float;
 };
 
 // The baseline copy always; the avx2 copy where this CPU runs it (the dispatch is then it).
 std::vector<Copy> copies() {
-  std::vector<Copy> all{{"baseline", dense::baseline::factorLower,
-                         dense::baseline::solveLowerTransposedRight,
-                         dense::baseline::subtractProductTransposed,
-                         dense::baseline::subtractGramLower}};
+  std::vector<Copy> all{
+      {"baseline", dense::baseline::factorLower, dense::baseline::solveLowerTransposedRight,
+       dense::baseline::subtractProductTransposed, dense::baseline::subtractGramLower,
+       dense::baseline::productTransposedFloat}};
 #if defined(CURVESFM_DENSE_AVX2)
   if (dense::avx2KernelsRun()) {
     all.push_back({"avx2", dense::avx2::factorLower, dense::avx2::solveLowerTransposedRight,
-                   dense::avx2::subtractProductTransposed, dense::avx2::subtractGramLower});
+                   dense::avx2::subtractProductTransposed, dense::avx2::subtractGramLower,
+                   dense::avx2::productTransposedFloat});
   }
 #endif
   return all;
@@ -91,18 +93,12 @@ TEST(DenseKernels, EveryCopyGivesExactDotProductsOfWholeNumberDescriptors) {
   const FloatRows a = (FloatRows::Random(37, 128).array() * 127.5f + 127.5f).round().matrix();
   const FloatRows b = (FloatRows::Random(53, 128).array() * 127.5f + 127.5f).round().matrix();
   const Eigen::MatrixXd expected = a.cast<double>() * b.cast<double>().transpose();
-  const std::vector<std::pair<std::string, decltype(&dense::productTransposedFloat)>> products = {
-    {"dispatch", dense::productTransposedFloat},
-    {"baseline", dense::baseline::productTransposedFloat},
-#if defined(CURVESFM_DENSE_AVX2)
-    {"avx2", dense::avx2KernelsRun() ? dense::avx2::productTransposedFloat
-                                     : dense::baseline::productTransposedFloat},
-#endif
-  };
-  for (const auto& [name, product] : products) {
+  std::vector<Copy> all = copies();
+  all.push_back({"dispatch", {}, {}, {}, {}, dense::productTransposedFloat});
+  for (const Copy& copy : all) {
     FloatRows c(37, 53);
-    product(a.data(), 37, b.data(), 53, 128, c.data());
-    EXPECT_EQ(c.cast<double>(), expected) << name;
+    copy.product_float(a.data(), 37, b.data(), 53, 128, c.data());
+    EXPECT_EQ(c.cast<double>(), expected) << copy.name;
   }
 }
 

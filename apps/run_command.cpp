@@ -28,6 +28,7 @@
 #include "core/peak_memory.h"
 #include "core/trajectory_evaluation.h"
 #include "core/tum_dataset.h"
+#include "frontend/mapping/start_model.h"
 
 namespace curvesfm {
 
@@ -715,6 +716,63 @@ void printSanity(const RunSanity& s) {
   for (const RunVerdict& v : s.verdicts) std::printf("warning: %s\n", v.message.c_str());
 }
 
+// The pinhole camera of the undistorted images (ImageUndistorter: the same K, no distortion),
+// which the initialiser's pixels refer to.
+Camera undistortedPinhole(const Camera& camera) {
+  CameraIntrinsics k = camera.intrinsics();
+  k.k1 = k.k2 = k.p1 = k.p2 = k.k3 = 0.0;
+  return Camera(k);
+}
+
+// What the images say about a given start (StartModel); when its poses are off each on its own,
+// the BA ties each keyframe to its start (the start prior, at the measured sigmas) instead of
+// tying each motion to the start's (the motion prior), unless the start prior was asked for.
+std::optional<StartModelEstimate> readStartModel(const RunInput& input,
+                                                 const StartModelOptions& options,
+                                                 CurveBundleAdjustmentOptions* ba, bool* switched) {
+  *switched = false;
+  if (!options.from_images || !input.initialisation || input.init_poses_source == "initialiser") {
+    return std::nullopt;
+  }
+  const StartModelEstimate e =
+      estimateStartModel(undistortedPinhole(input.sequence.camera), *input.initialisation, options);
+  std::printf(
+      "start: %s (%d frames registered again on their points move %.3g deg, %.2f x the PnP's own "
+      "noise, and %.3g spacings RMS per axis; their rotations' variogram grows %.2f x from lag 1 "
+      "to %d)",
+      toString(e.model).c_str(), e.frames_measured, e.rotation_rms_deg, e.rotation_to_measurement,
+      e.centre_rms_spacings, e.variogram_growth, e.variogram_lag);
+  if (e.model == StartModel::kPerPose && !ba->start_prior) {
+    ba->motion_prior = false;
+    ba->start_prior = true;
+    ba->start_prior_rotation_sigma_deg = e.rotation_rms_deg;
+    // The centre's sigma is relative to the keyframes' spacing, which for every frame a keyframe
+    // (the benches) is the frames' one measured here.
+    ba->start_prior_centre_sigma_rel = std::max(e.centre_rms_spacings, 1e-6);
+    *switched = true;
+    std::printf(
+        "; the BA ties each keyframe to its start (start prior %.3g deg, %.3g spacings) "
+        "instead of each motion to the start's",
+        ba->start_prior_rotation_sigma_deg, ba->start_prior_centre_sigma_rel);
+  }
+  std::printf("\n");
+  return e;
+}
+
+nlohmann::json startModelJson(const std::optional<StartModelEstimate>& e, bool switched) {
+  if (!e) return nullptr;
+  return {{"model", toString(e->model)},
+          {"frames_measured", e->frames_measured},
+          {"rotation_rms_deg", e->rotation_rms_deg},
+          {"centre_rms", e->centre_rms},
+          {"centre_rms_spacings", e->centre_rms_spacings},
+          {"rotation_to_measurement", e->rotation_to_measurement},
+          {"neighbour_correlation", e->neighbour_correlation},
+          {"variogram_lag", e->variogram_lag},
+          {"variogram_growth", e->variogram_growth},
+          {"switched_to_start_prior", switched}};
+}
+
 bool globalBaUsable(const ScheduleReport& report) {
   for (const ScheduleRound& round : report.rounds) {
     if (!round.skipped && !round.summary.usable) return false;
@@ -782,6 +840,7 @@ RunCommand::RunCommand(CLI::App* app) {
       ->capture_default_str();
   addImageSequenceOptions(&table_, &sequence_);
   addPointInitialiserOptions(&table_, &initialiser_, "/points");
+  addStartModelOptions(&table_, &start_model_, "/start_model");
   addPipelineOptions(&table_, &options_, "/pipeline");
   const OptionPlace overlay_place{"/overlay", "overlay-", "Overlays", ""};
   addCurveOverlayOptions(&table_, &overlay_, overlay_place);
@@ -892,6 +951,9 @@ int RunCommand::run() const {
               input.init_poses_source.c_str(), d.camera.width(), d.camera.height());
 
   PipelineOptions options = options_;
+  bool start_prior_switched = false;
+  const std::optional<StartModelEstimate> start_model =
+      readStartModel(input, start_model_, &options.ba, &start_prior_switched);
   options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
   std::unique_ptr<Pipeline> pipeline;
   PipelineResult result;
@@ -956,6 +1018,7 @@ int RunCommand::run() const {
        {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
                                             : nlohmann::json(nullptr)},
        {"camera", cameraToJson(pipeline->undistortedCamera())},
+       {"start_model", startModelJson(start_model, start_prior_switched)},
        {"scene_scale", result.scene_scale},
        {"counts",
         {{"frames", input.frames.size()},

@@ -9,6 +9,7 @@
 #include "frontend/image/curve_overlay.h"
 #include "frontend/mapping/pipeline.h"
 #include "frontend/mapping/point_initialiser.h"
+#include "frontend/mapping/start_model.h"
 
 namespace curvesfm {
 
@@ -71,6 +72,7 @@ class RunCommand {
   bool images_ahead_ = true;
   ImageSequenceOptions sequence_;
   PointInitialiserOptions initialiser_;
+  StartModelOptions start_model_;
   PipelineOptions options_;
   CurveOverlayOptions overlay_;
   OverlayColouringOptions overlay_colouring_;

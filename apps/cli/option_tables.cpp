@@ -423,6 +423,28 @@ void addSanityOptions(OptionsTable* table, SanityOptions* o, const OptionPlace& 
               "Verdict when the final map has fewer curves");
 }
 
+void addStartModelOptions(OptionsTable* table, StartModelOptions* o, const std::string& path) {
+  table->group(o, "StartModelOptions", path, "start-model-", "Start model")
+      .boolean("from_images", "from-images", &o->from_images,
+               "With given initial poses, register each frame again on the points triangulated "
+               "at them; when the poses are off each on its own, tie each keyframe to its start "
+               "(start prior, measured sigmas) instead of each motion to the start's")
+      .number("min_points", "min-points", &o->min_points, "Points a measured frame sees at least")
+      .number("min_frames", "min-frames", &o->min_frames, "Measured frames a verdict needs")
+      .number("min_rotation_deg", "min-rotation", &o->min_rotation_deg,
+              "Frames that move less than this (RMS per axis) agree with the images (deg)")
+      .number("min_rotation_to_measurement", "min-rotation-to-measurement",
+              &o->min_rotation_to_measurement,
+              "... as do frames that move less than this many times the PnP rotation's own noise")
+      .number("max_variogram_lag", "max-variogram-lag", &o->max_variogram_lag,
+              "The moves' variogram is read at lags 1 and min(this, measured frames / 3)")
+      .number("max_variogram_growth", "max-variogram-growth", &o->max_variogram_growth,
+              "Above min-rotation, the start is off per pose when the variogram grows at most "
+              "this much from lag 1 to that lag (else it drifts)")
+      .number("max_reprojection_error_px", "max-reprojection-error", &o->max_reprojection_error_px,
+              "PnP's inlier threshold (px)");
+}
+
 void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::string& path) {
   table->group(o, "PipelineOptions", path, "", "Pipeline")
       .number("scene_scale", "scene-scale", &o->scene_scale,

@@ -17,6 +17,7 @@
 #include "frontend/image/two_view_geometry.h"
 #include "frontend/mapping/pipeline.h"
 #include "frontend/mapping/point_initialiser.h"
+#include "frontend/mapping/start_model.h"
 #include "graph/optimizer.h"
 #include "graph/scheduler.h"
 #include "sim/curve_scene.h"
@@ -54,6 +55,7 @@ void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentO
 /// Every stage of the pipeline under `path`, flags named by stage (`--edges-*`, `--depth-*`,
 /// `--local-ba-*`, ...).
 void addPipelineOptions(OptionsTable* table, PipelineOptions* options, const std::string& path);
+void addStartModelOptions(OptionsTable* table, StartModelOptions* options, const std::string& path);
 /// The sanity checks of the pipeline (`--sanity-*` in run).
 void addSanityOptions(OptionsTable* table, SanityOptions* options, const OptionPlace& place);
 void addCurveOverlayOptions(OptionsTable* table, CurveOverlayOptions* options,

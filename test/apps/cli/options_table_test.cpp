@@ -25,6 +25,7 @@ struct AllOptions {
   CurveOverlayOptions overlay;
   OverlayColouringOptions overlay_colouring;
   PointInitialiserOptions points;
+  StartModelOptions start_model;
   ImageSequenceOptions sequence;
   CurveSceneOptions curve_scene;
   CurveBundleAdjustmentOptions curve_ba;
@@ -47,6 +48,7 @@ std::vector<OptionsTable> commandTables(AllOptions* o) {
   addOverlayColouringOptions(&tables[0], &o->overlay_colouring,
                              {"/overlay", "overlay-", "Overlays", ""});
   addPointInitialiserOptions(&tables[0], &o->points, "/points");
+  addStartModelOptions(&tables[0], &o->start_model, "/start_model");
   addImageSequenceOptions(&tables[0], &o->sequence);
   addCurveSceneOptions(&tables[1], &o->curve_scene, {"/scene", "", "Scene", ""});
   addCurveBundleAdjustmentOptions(&tables[1], &o->curve_ba, {"/ba", "", "Objective", ""});

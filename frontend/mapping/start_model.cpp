@@ -132,9 +132,9 @@ double neighbourCorrelation(const std::vector<FrameMove>& moves) {
   return denominator > 0.0 ? cross / denominator : 0.0;
 }
 
-// Mean squared difference of the rotation moves of frames `lag` apart (rad^2); 0 without such a
-// pair.
-double rotationVariogram(const std::vector<FrameMove>& moves, int lag) {
+// Mean squared difference of the rotation moves of frames `lag` apart (rad^2); none without such
+// a pair.
+std::optional<double> rotationVariogram(const std::vector<FrameMove>& moves, int lag) {
   double sum = 0.0;
   int pairs = 0;
   std::size_t j = 0;
@@ -145,7 +145,8 @@ double rotationVariogram(const std::vector<FrameMove>& moves, int lag) {
     sum += (moves[j].rotation - moves[i].rotation).squaredNorm();
     ++pairs;
   }
-  return pairs > 0 ? sum / pairs : 0.0;
+  if (pairs == 0) return std::nullopt;
+  return sum / pairs;
 }
 
 }  // namespace
@@ -156,7 +157,7 @@ StartModelEstimate estimateStartModel(const Camera& camera, const PointInitialis
   StartModelEstimate estimate;
   const std::vector<FrameMove> moves = measureFrameMoves(camera, points, options);
   estimate.frames_measured = static_cast<int>(moves.size());
-  if (estimate.frames_measured < options.min_frames) return estimate;
+  if (moves.empty()) return estimate;
 
   double rotation_sq = 0.0, centre_sq = 0.0, measurement_sq = 0.0;
   for (const FrameMove& move : moves) {
@@ -173,10 +174,12 @@ StartModelEstimate estimateStartModel(const Camera& camera, const PointInitialis
   estimate.centre_rms_spacings = spacing > 0.0 ? estimate.centre_rms / spacing : 0.0;
   estimate.neighbour_correlation = neighbourCorrelation(moves);
   estimate.variogram_lag = std::clamp(estimate.frames_measured / 3, 2, options.max_variogram_lag);
-  const double v1 = rotationVariogram(moves, 1);
-  estimate.variogram_growth =
-      v1 > 0.0 ? rotationVariogram(moves, estimate.variogram_lag) / v1 : 0.0;
+  const std::optional<double> v1 = rotationVariogram(moves, 1);
+  const std::optional<double> vk = rotationVariogram(moves, estimate.variogram_lag);
+  if (v1 && vk && *v1 > 0.0) estimate.variogram_growth = *vk / *v1;
 
+  // Without enough frames, or without frames 1 and k apart, the moves say nothing of the kind.
+  if (estimate.frames_measured < options.min_frames || !v1 || !vk) return estimate;
   if (estimate.rotation_rms_deg < options.min_rotation_deg ||
       estimate.rotation_to_measurement < options.min_rotation_to_measurement) {
     estimate.model = StartModel::kConsistent;

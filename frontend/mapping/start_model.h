@@ -26,7 +26,7 @@ namespace curvesfm {
 
 /// What the images say about the given start.
 enum class StartModel {
-  kNotMeasured,  ///< Too few frames saw enough points (or the start came from the initialiser).
+  kNotMeasured,  ///< Too few frames saw enough points, or none are 1 and k apart (see below).
   kConsistent,   ///< The frames move by less than min_rotation_deg: the start agrees with them.
   kDrifting,     ///< They move more, farther apart more unlike: a drift, the motion prior's.
   kPerPose,      ///< They move more, as unlike at any lag: an error independent per pose.
@@ -56,20 +56,21 @@ struct StartModelOptions {
   /// gave verdicts that flipped between noise seeds of one kind (docs/benchmarks.md). >= 3.
   int min_frames = 20;
   /// A start whose frames move by less than this, RMS per axis, agrees with the images (deg).
-  /// Above the measurement's own noise: a true start moves 0.005-0.037 deg on the real sets with
-  /// ordered views, 0.06 deg on templeSparseRing (docs/benchmarks.md). Finite, > 0.
+  /// Above the measurement's own noise: a true start moves 0.005-0.037 deg on fountain-P11,
+  /// Pavilion, KITTI 06 and templeRing (7-Scenes' ground truth, good to 1-2 cm, 0.15 deg;
+  /// docs/benchmarks.md). Finite, > 0.
   double min_rotation_deg = 0.04;
   /// ... nor when they move less than this many times the PnP rotation's own standard deviation
   /// (from its inliers' reprojection scatter; unitless, RMS over the frames): on a weakly
-  /// textured view (a logo on a plane) that noise alone is 0.1 deg. Finite, > 0.
+  /// textured view (a logo on a plane) that noise alone is 0.06-0.1 deg. Finite, > 0.
   double min_rotation_to_measurement = 3.0;
   /// The variogram is read at lags 1 and k = min(this, measured frames / 3) (frames). In [2, 100].
   int max_variogram_lag = 8;
   /// Above min_rotation_deg, the start is off per pose when the rotation moves' mean squared
   /// difference at lag k is at most this many times that at lag 1 (unitless; 1 for errors
   /// independent per pose, about min(k, track length) for a random walk). Measured at lag 8:
-  /// 0.8-1.4 for the benches' independent noise, 1.8-3.4 for drifts and the 7-Scenes ground truth's
-  /// own error (docs/benchmarks.md). Finite, > 0.
+  /// 0.85-1.46 for noise applied per pose (Pavilion, KITTI 06, planar scenes), 1.7-5.6 for the
+  /// planar drift starts and 7-Scenes' ground truth (docs/benchmarks.md). Finite, > 0.
   double max_variogram_growth = 1.6;
   /// PnP's inlier threshold on the reprojection error (px). Finite, > 0.
   double max_reprojection_error_px = 4.0;

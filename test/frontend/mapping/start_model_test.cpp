@@ -116,6 +116,19 @@ TEST(StartModel, TooFewFramesGiveNoVerdict) {
             StartModel::kNotMeasured);
 }
 
+TEST(StartModel, FramesWithoutNeighboursGiveNoVerdictOnTheKind) {
+  const PointScene s = scene();
+  PointInitialisation init = atPoses(s, rotated(s, independentTurns(40, 0.2, 7)));
+  // Every other frame unposed: no two measured frames are one apart.
+  for (std::size_t f = 1; f < init.frames.size(); f += 2) init.frames[f].cam_from_world.reset();
+  StartModelOptions o;
+  o.min_frames = 10;
+  const StartModelEstimate e = estimateStartModel(*s.camera, init, o);
+  EXPECT_EQ(e.frames_measured, 20);
+  EXPECT_GT(e.rotation_rms_deg, 0.1);  // Measured all the same.
+  EXPECT_EQ(e.model, StartModel::kNotMeasured);
+}
+
 TEST(StartModel, BadOptionsNameTheField) {
   StartModelOptions o;
   o.max_variogram_growth = 0.0;

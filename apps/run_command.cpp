@@ -745,10 +745,11 @@ std::optional<StartModelEstimate> readStartModel(const RunInput& input,
   if (e.model == StartModel::kPerPose && !ba->start_prior) {
     ba->motion_prior = false;
     ba->start_prior = true;
-    ba->start_prior_rotation_sigma_deg = e.rotation_rms_deg;
+    ba->start_prior_rotation_sigma_deg = options.prior_sigma_scale * e.rotation_rms_deg;
     // The centre's sigma is relative to the keyframes' spacing, which for every frame a keyframe
     // (the benches) is the frames' one measured here.
-    ba->start_prior_centre_sigma_rel = std::max(e.centre_rms_spacings, 1e-6);
+    ba->start_prior_centre_sigma_rel =
+        std::max(options.prior_sigma_scale * e.centre_rms_spacings, 1e-6);
     *switched = true;
     std::printf(
         "; the BA ties each keyframe to its start (start prior %.3g deg, %.3g spacings) "

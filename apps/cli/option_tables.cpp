@@ -441,6 +441,8 @@ void addStartModelOptions(OptionsTable* table, StartModelOptions* o, const std::
       .number("max_variogram_growth", "max-variogram-growth", &o->max_variogram_growth,
               "Above min-rotation, the start is off per pose when the variogram grows at most "
               "this much from lag 1 to that lag (else it drifts)")
+      .number("prior_sigma_scale", "prior-sigma-scale", &o->prior_sigma_scale,
+              "A start off per pose is tied to its poses at this times the measured noise")
       .number("max_reprojection_error_px", "max-reprojection-error", &o->max_reprojection_error_px,
               "PnP's inlier threshold (px)");
 }

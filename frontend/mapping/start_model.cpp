@@ -20,6 +20,8 @@ void StartModelOptions::validate() const {
   require(max_variogram_lag >= 2 && max_variogram_lag <= 100, "max_variogram_lag",
           max_variogram_lag, "in [2, 100]");
   require.positive("max_variogram_growth", max_variogram_growth);
+  require(prior_sigma_scale > 0.0 && prior_sigma_scale <= 10.0, "prior_sigma_scale",
+          prior_sigma_scale, "in (0, 10]");
   require.positive("max_reprojection_error_px", max_reprojection_error_px);
 }
 

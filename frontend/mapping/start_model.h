@@ -72,6 +72,12 @@ struct StartModelOptions {
   /// 0.85-1.46 for noise applied per pose (Pavilion, KITTI 06, planar scenes), 1.7-5.6 for the
   /// planar drift starts and 7-Scenes' ground truth (docs/benchmarks.md). Finite, > 0.
   double max_variogram_growth = 1.6;
+  /// A start off per pose is tied to each of its poses with std devs of this times the measured
+  /// rotation and centre noise (unitless): the edge term counts each segment's shared error once
+  /// per sample, so a prior at the true noise loses to it, as the motion prior's sigmas are the
+  /// drift's over 2.5 (CurveBundleAdjustmentOptions). Pavilion noise seed 1, refined / start at
+  /// 1 / 0.4 of the measured sigmas: 0.99 / 0.65 x (docs/benchmarks.md). In (0, 10].
+  double prior_sigma_scale = 0.4;
   /// PnP's inlier threshold on the reprojection error (px). Finite, > 0.
   double max_reprojection_error_px = 4.0;
 

@@ -428,7 +428,8 @@ void addStartModelOptions(OptionsTable* table, StartModelOptions* o, const std::
       .boolean("from_images", "from-images", &o->from_images,
                "With given initial poses, register each frame again on the points triangulated "
                "at them; when the poses are off each on its own, tie each keyframe to its start "
-               "(start prior, measured sigmas) instead of each motion to the start's")
+               "(start prior, at prior-sigma-scale times the measured sigmas) instead of each "
+               "motion to the start's")
       .number("min_points", "min-points", &o->min_points, "Points a measured frame sees at least")
       .number("min_frames", "min-frames", &o->min_frames, "Measured frames a verdict needs")
       .number("min_rotation_deg", "min-rotation", &o->min_rotation_deg,

@@ -1,7 +1,6 @@
 #pragma once
 
 #include <array>
-#include <string>
 #include <utility>
 
 #include "core/camera.h"
@@ -27,7 +26,8 @@ namespace curvesfm {
 /// What the images say about the given start.
 enum class StartModel {
   kNotMeasured,  ///< Too few frames saw enough points, or none are 1 and k apart (see below).
-  kConsistent,   ///< The frames move by less than min_rotation_deg: the start agrees with them.
+  kConsistent,   ///< The frames move too little (below min_rotation_deg, or within a few times
+                 ///< the PnP's own noise): the start agrees with the images as far as they tell.
   kDrifting,     ///< They move more, farther apart more unlike: a drift, the motion prior's.
   kPerPose,      ///< They move more, as unlike at any lag: an error independent per pose.
 };
@@ -46,8 +46,8 @@ struct EnumNames<StartModel> {
 /// start, CurveBundleAdjustmentOptions::start_prior, instead of the motion prior).
 struct StartModelOptions {
   /// Measure the start and, when it is off per pose, switch the BA from the motion prior to the
-  /// start prior with the measured sigmas (run only, with given initial poses; an explicit
-  /// --ba-start-prior keeps its own sigmas).
+  /// start prior at prior_sigma_scale times the measured sigmas (run only, with given initial
+  /// poses; an explicit --ba-start-prior keeps its own sigmas).
   bool from_images = true;
   /// A frame is measured only if it sees at least this many of the points (count). >= 6.
   int min_points = 30;

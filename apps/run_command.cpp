@@ -716,26 +716,18 @@ void printSanity(const RunSanity& s) {
   for (const RunVerdict& v : s.verdicts) std::printf("warning: %s\n", v.message.c_str());
 }
 
-// The pinhole camera of the undistorted images (ImageUndistorter: the same K, no distortion),
-// which the initialiser's pixels refer to.
-Camera undistortedPinhole(const Camera& camera) {
-  CameraIntrinsics k = camera.intrinsics();
-  k.k1 = k.k2 = k.p1 = k.p2 = k.k3 = 0.0;
-  return Camera(k);
-}
-
 // What the images say about a given start (StartModel); when its poses are off each on its own,
 // the BA ties each keyframe to its start (the start prior, at the measured sigmas) instead of
 // tying each motion to the start's (the motion prior), unless the start prior was asked for.
 std::optional<StartModelEstimate> readStartModel(const RunInput& input,
                                                  const StartModelOptions& options,
-                                                 CurveBundleAdjustmentOptions* ba, bool* switched) {
-  *switched = false;
+                                                 CurveBundleAdjustmentOptions* ba) {
   if (!options.from_images || !input.initialisation || input.init_poses_source == "initialiser") {
     return std::nullopt;
   }
   const StartModelEstimate e =
-      estimateStartModel(undistortedPinhole(input.sequence.camera), *input.initialisation, options);
+      // The initialiser's pixels are those of the undistorted images (ImageUndistorter).
+      estimateStartModel(input.sequence.camera.withoutDistortion(), *input.initialisation, options);
   std::printf(
       "start: %s (%d frames registered again on their points move %.3g deg, %.2f x the PnP's own "
       "noise, and %.3g spacings RMS per axis; their rotations' variogram grows %.2f x from lag 1 "
@@ -750,7 +742,6 @@ std::optional<StartModelEstimate> readStartModel(const RunInput& input,
     // (the benches) is the frames' one measured here.
     ba->start_prior_centre_sigma_rel =
         std::max(options.prior_sigma_scale * e.centre_rms_spacings, 1e-6);
-    *switched = true;
     std::printf(
         "; the BA ties each keyframe to its start (start prior %.3g deg, %.3g spacings) "
         "instead of each motion to the start's",
@@ -768,7 +759,6 @@ nlohmann::json startModelJson(const std::optional<StartModelEstimate>& e, bool s
           {"centre_rms", e->centre_rms},
           {"centre_rms_spacings", e->centre_rms_spacings},
           {"rotation_to_measurement", e->rotation_to_measurement},
-          {"neighbour_correlation", e->neighbour_correlation},
           {"variogram_lag", e->variogram_lag},
           {"variogram_growth", e->variogram_growth},
           {"switched_to_start_prior", switched}};
@@ -952,9 +942,8 @@ int RunCommand::run() const {
               input.init_poses_source.c_str(), d.camera.width(), d.camera.height());
 
   PipelineOptions options = options_;
-  bool start_prior_switched = false;
   const std::optional<StartModelEstimate> start_model =
-      readStartModel(input, start_model_, &options.ba, &start_prior_switched);
+      readStartModel(input, start_model_, &options.ba);
   options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
   std::unique_ptr<Pipeline> pipeline;
   PipelineResult result;
@@ -1019,7 +1008,8 @@ int RunCommand::run() const {
        {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
                                             : nlohmann::json(nullptr)},
        {"camera", cameraToJson(pipeline->undistortedCamera())},
-       {"start_model", startModelJson(start_model, start_prior_switched)},
+       {"start_model",
+        startModelJson(start_model, options.ba.start_prior && !options_.ba.start_prior)},
        {"scene_scale", result.scene_scale},
        {"counts",
         {{"frames", input.frames.size()},

@@ -86,6 +86,12 @@ bool Camera::hasDistortion() const {
   return c.k1 != 0.0 || c.k2 != 0.0 || c.p1 != 0.0 || c.p2 != 0.0 || c.k3 != 0.0;
 }
 
+Camera Camera::withoutDistortion() const {
+  CameraIntrinsics pinhole = intrinsics_;
+  pinhole.k1 = pinhole.k2 = pinhole.p1 = pinhole.p2 = pinhole.k3 = 0.0;
+  return Camera(pinhole);
+}
+
 bool Camera::project(const Eigen::Vector3d& point_in_cam, Eigen::Vector2d* pixel,
                      Matrix23d* H_point) const {
   const double z = point_in_cam.z();

@@ -64,6 +64,8 @@ class Camera {
 
   /// True if any of k1, k2, p1, p2, k3 is non-zero.
   bool hasDistortion() const;
+  /// The same K and size without distortion: the camera of this one's undistorted images.
+  Camera withoutDistortion() const;
 
   /// Projects a point in the camera frame to a (distorted) pixel.
   /// H_point (optional, 2x3): d pixel / d point_in_cam, distortion included.

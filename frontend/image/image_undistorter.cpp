@@ -9,11 +9,6 @@
 namespace curvesfm {
 namespace {
 
-CameraIntrinsics withoutDistortion(CameraIntrinsics intrinsics) {
-  intrinsics.k1 = intrinsics.k2 = intrinsics.p1 = intrinsics.p2 = intrinsics.k3 = 0.0;
-  return intrinsics;
-}
-
 // For every pixel of the pinhole image, where its ray meets the distorted source image.
 void sourcePositions(const Camera& source, cv::Mat* map_x, cv::Mat* map_y) {
   const int width = source.width();
@@ -65,7 +60,7 @@ void ImageUndistorterOptions::validate() const {
 
 ImageUndistorter::ImageUndistorter(const Camera& distorted_camera,
                                    const ImageUndistorterOptions& options)
-    : source_(distorted_camera), pinhole_(withoutDistortion(distorted_camera.intrinsics())) {
+    : source_(distorted_camera), pinhole_(distorted_camera.withoutDistortion()) {
   options.validate();
   if (isIdentity()) {
     valid_mask_ = cv::Mat(source_.height(), source_.width(), CV_8UC1, cv::Scalar(255));

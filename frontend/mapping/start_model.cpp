@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "core/pose3.h"
 #include "core/so3.h"
 #include "frontend/image/absolute_pose.h"
 
@@ -105,33 +106,13 @@ std::vector<FrameMove> measureFrameMoves(const Camera& camera, const PointInitia
   return moves;
 }
 
-double meanCentreSpacing(const PointInitialisation& init) {
-  std::optional<Eigen::Vector3d> previous;
-  double sum = 0.0;
-  int count = 0;
+// The mean distance between consecutive posed frames' camera centres (pose units).
+double meanPosedStep(const PointInitialisation& init) {
+  std::vector<Pose3> posed;
   for (const InitialisedFrame& frame : init.frames) {
-    if (!frame.cam_from_world) continue;
-    const Eigen::Vector3d centre = frame.cam_from_world->inverseTranslation();
-    if (previous) {
-      sum += (centre - *previous).norm();
-      ++count;
-    }
-    previous = centre;
+    if (frame.cam_from_world) posed.push_back(*frame.cam_from_world);
   }
-  return count > 0 ? sum / count : 0.0;
-}
-
-// Correlation of consecutive moves' rotation vectors (uncentred: a common rotation of every
-// frame is a gauge the points absorb, not an error the moves show).
-double neighbourCorrelation(const std::vector<FrameMove>& moves) {
-  double cross = 0.0, first = 0.0, second = 0.0;
-  for (std::size_t i = 1; i < moves.size(); ++i) {
-    cross += moves[i - 1].rotation.dot(moves[i].rotation);
-    first += moves[i - 1].rotation.squaredNorm();
-    second += moves[i].rotation.squaredNorm();
-  }
-  const double denominator = std::sqrt(first * second);
-  return denominator > 0.0 ? cross / denominator : 0.0;
+  return meanCameraStep(posed);
 }
 
 // Mean squared difference of the rotation moves of frames `lag` apart (rad^2); none without such
@@ -172,9 +153,8 @@ StartModelEstimate estimateStartModel(const Camera& camera, const PointInitialis
   const double per_axis = 3.0 * static_cast<double>(moves.size());
   estimate.rotation_rms_deg = std::sqrt(rotation_sq / per_axis) * kDegreesPerRadian;
   estimate.centre_rms = std::sqrt(centre_sq / per_axis);
-  const double spacing = meanCentreSpacing(points);
+  const double spacing = meanPosedStep(points);
   estimate.centre_rms_spacings = spacing > 0.0 ? estimate.centre_rms / spacing : 0.0;
-  estimate.neighbour_correlation = neighbourCorrelation(moves);
   estimate.variogram_lag = std::clamp(estimate.frames_measured / 3, 2, options.max_variogram_lag);
   const std::optional<double> v1 = rotationVariogram(moves, 1);
   const std::optional<double> vk = rotationVariogram(moves, estimate.variogram_lag);

@@ -98,8 +98,6 @@ struct StartModelEstimate {
   double centre_rms_spacings = 0.0;
   /// The rotation moves over the PnP rotation's own standard deviation (RMS over the frames).
   double rotation_to_measurement = 0.0;
-  /// Correlation of consecutive measured frames' rotation moves (unitless, in [-1, 1]).
-  double neighbour_correlation = 0.0;
   /// The lag k (frames) and the variogram's growth from lag 1 to it (StartModelOptions).
   int variogram_lag = 0;
   double variogram_growth = 0.0;

@@ -139,6 +139,11 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   EXPECT_THAT(result.output,
               HasSubstr("--ba-start-prior-centre = 0: must be > 0 and finite "
                         "(CurveBundleAdjustmentOptions.start_prior_centre_sigma_rel)"));
+  result = run("--start-model-max-variogram-growth -1");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output,
+              HasSubstr("--start-model-max-variogram-growth = -1: must be > 0 and finite "
+                        "(StartModelOptions.max_variogram_growth)"));
   // The same struct in two places: the error names the place's flag.
   result = run("--global-ba-max-rounds 0");
   EXPECT_EQ(result.exit_code, 2);

@@ -744,8 +744,10 @@ std::optional<StartModelEstimate> readStartModel(const RunInput& input,
         std::max(options.prior_sigma_scale * e.centre_rms_spacings, 1e-6);
     std::printf(
         "; the BA ties each keyframe to its start (start prior %.3g deg, %.3g spacings) "
-        "instead of each motion to the start's",
-        ba->start_prior_rotation_sigma_deg, ba->start_prior_centre_sigma_rel);
+        "instead of each motion to the start's, and lifts the map again at the refined poses "
+        "(--start-model-relift-passes %d)",
+        ba->start_prior_rotation_sigma_deg, ba->start_prior_centre_sigma_rel,
+        options.relift_passes);
   }
   std::printf("\n");
   return e;
@@ -811,7 +813,8 @@ RunCommand::RunCommand(CLI::App* app) {
   c->add_option("--relift-passes", relift_passes_,
                 "After the run, this many more, each lifting and registering the curves again at "
                 "the previous one's refined poses, with BA started from and its priors tied to "
-                "the initial poses (each pass costs a run)")
+                "the initial poses (each pass costs a run; a start the images call off per pose "
+                "gets at least --start-model-relift-passes)")
       ->capture_default_str();
   c->add_flag("--overlays", overlays_,
               "Write OUT/overlays/NNNNNN.png, the final curves drawn on keyframe NNNNNN coloured "
@@ -947,11 +950,14 @@ int RunCommand::run() const {
   options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
   std::unique_ptr<Pipeline> pipeline;
   PipelineResult result;
+  const bool per_pose_start = options.ba.start_prior && !options_.ba.start_prior;
+  const int relift_passes =
+      std::max(relift_passes_, per_pose_start ? start_model_.relift_passes : 0);
   std::vector<Pose3> frontend_poses = input.frontend_poses;
   double image_wait_seconds = 0.0;
-  for (int pass = 0; pass <= relift_passes_; ++pass) {
+  for (int pass = 0; pass <= relift_passes; ++pass) {
     if (pass > 0) {
-      printReliftPass(pass, relift_passes_, evaluateAte(result, d));
+      printReliftPass(pass, relift_passes, evaluateAte(result, d));
       frontend_poses = reliftPoses(input, frontend_poses, result);
     }
     pipeline = std::make_unique<Pipeline>(d.camera, options);
@@ -1008,8 +1014,8 @@ int RunCommand::run() const {
        {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
                                             : nlohmann::json(nullptr)},
        {"camera", cameraToJson(pipeline->undistortedCamera())},
-       {"start_model",
-        startModelJson(start_model, options.ba.start_prior && !options_.ba.start_prior)},
+       {"start_model", startModelJson(start_model, per_pose_start)},
+       {"relift_passes_run", relift_passes},
        {"scene_scale", result.scene_scale},
        {"counts",
         {{"frames", input.frames.size()},

@@ -444,6 +444,9 @@ void addStartModelOptions(OptionsTable* table, StartModelOptions* o, const std::
               "this much from lag 1 to that lag (else it drifts)")
       .number("prior_sigma_scale", "prior-sigma-scale", &o->prior_sigma_scale,
               "A start off per pose is tied to its poses at this times the measured noise")
+      .number("relift_passes", "relift-passes", &o->relift_passes,
+              "A start off per pose is lifted again at the refined poses this many times (at "
+              "least: --relift-passes may ask more)")
       .number("max_reprojection_error_px", "max-reprojection-error", &o->max_reprojection_error_px,
               "PnP's inlier threshold (px)");
 }

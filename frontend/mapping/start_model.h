@@ -78,6 +78,14 @@ struct StartModelOptions {
   /// drift's over 2.5 (CurveBundleAdjustmentOptions). Pavilion noise seed 1, refined / start at
   /// 1 / 0.4 of the measured sigmas: 0.99 / 0.65 x (docs/benchmarks.md). In (0, 10].
   double prior_sigma_scale = 0.4;
+  /// A start off per pose runs the pipeline this many more times (at least; --relift-passes may
+  /// ask more), each lifting and registering the map again at the previous pass's refined poses
+  /// under the same start prior: the map lifted at the noisy start holds its noise, one lifted at
+  /// better poses gives better poses. Refined / start, one pass against none, noise seeds 1-3:
+  /// Pavilion 0.50-0.53 against 0.66-0.71 x, KITTI 06 0.50-0.63 against 0.74-0.91 x, planar
+  /// per-pose starts 0.46-1.10 against 0.64-1.08 x (docs/benchmarks.md, session 34); it doubles
+  /// the run's time. In [0, 100].
+  int relift_passes = 1;
   /// PnP's inlier threshold on the reprojection error (px). Finite, > 0.
   double max_reprojection_error_px = 4.0;
 

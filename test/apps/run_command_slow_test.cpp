@@ -19,6 +19,7 @@ namespace curvesfm {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 using testing::CommandResult;
@@ -152,9 +153,6 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_TRUE(std::filesystem::exists(path("again") + "/overlays/000005.png"));
 }
 
-// The fit checks after global BA: with a residual bound no curve meets, every curve of the global
-// map is found implausible for its residual, dropped and counted under its reason, and a run
-// left with nothing plausible says so and fails.
 TEST_F(RunCommandTest, AReliftPassLiftsTheMapAtTheRefinedPosesAndStartsBaFromTheInitialOnes) {
   // Every frame is a keyframe. The relift pass's incremental stage works at the first run's
   // refined poses, so its move from the start is the first run's final move; its BA then starts
@@ -194,6 +192,37 @@ TEST_F(RunCommandTest, AReliftPassLiftsTheMapAtTheRefinedPosesAndStartsBaFromThe
   }
 }
 
+// A start the images read as off per pose is lifted again once by default. The short sequence is
+// too short for a verdict under the defaults, so the test lowers every threshold until any
+// measured start is per pose: what it checks is the run's response to that verdict.
+TEST_F(RunCommandTest, AStartOffPerPoseIsLiftedAgainOnce) {
+  const std::string dataset = writeShortPlanarDataset();
+  const std::string flags = shortPlanarFlags() +
+                            " --threads 1 --start-model-min-frames 3 --start-model-min-points 6"
+                            " --start-model-min-rotation 1e-12"
+                            " --start-model-min-rotation-to-measurement 1e-12"
+                            " --start-model-max-variogram-growth 1e12";
+  const auto runInto = [&](const std::string& out, const std::string& extra) {
+    const CommandResult r =
+        runCurvesfm("run --dataset " + dataset + " --out " + path(out) + flags + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream report_file(path(out + "/report.json"));
+    return std::make_pair(r, nlohmann::json::parse(report_file));
+  };
+  const auto [output, report] = runInto("per_pose", "");
+  ASSERT_EQ(report["start_model"]["model"], "per_pose") << output.output;
+  EXPECT_TRUE(report["start_model"]["switched_to_start_prior"].get<bool>());
+  EXPECT_EQ(report["relift_passes_run"], 1);
+  EXPECT_THAT(output.output, HasSubstr("relift 1 of 1: lifting the curves again"));
+
+  const auto [none_output, none] = runInto("no_relift", " --start-model-relift-passes 0");
+  EXPECT_EQ(none["relift_passes_run"], 0);
+  EXPECT_THAT(none_output.output, Not(HasSubstr("relift 1 of")));
+}
+
+// The fit checks after global BA: with a residual bound no curve meets, every curve of the global
+// map is found implausible for its residual, dropped and counted under its reason, and a run
+// left with nothing plausible says so and fails.
 TEST_F(RunCommandTest, FitChecksDropCurvesThatDoNotFitTheirViews) {
   const std::string dataset = writeShortPlanarDataset();
   const std::string out = path("fit_out");

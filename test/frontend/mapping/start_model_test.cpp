@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "core/errors.h"
@@ -133,6 +134,14 @@ TEST(StartModel, BadOptionsNameTheField) {
   StartModelOptions o;
   o.max_variogram_growth = 0.0;
   EXPECT_THROW(o.validate(), InvalidOptions);
+  o = StartModelOptions();
+  o.relift_passes = -1;
+  try {
+    o.validate();
+    ADD_FAILURE() << "relift_passes -1 accepted";
+  } catch (const InvalidOptions& e) {
+    EXPECT_NE(std::string(e.what()).find("relift_passes"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -26,8 +26,9 @@ namespace curvesfm {
 /// What the images say about the given start.
 enum class StartModel {
   kNotMeasured,  ///< Too few frames saw enough points, or none are 1 and k apart (see below).
-  kConsistent,   ///< The frames move too little (below min_rotation_deg, or within a few times
-                 ///< the PnP's own noise): the start agrees with the images as far as they tell.
+  kConsistent,   ///< The frames move too little (below min_rotation_deg, or within
+                 ///< min_rotation_to_measurement times the PnP's own noise): the start agrees
+                 ///< with the images as far as they tell.
   kDrifting,     ///< They move more, farther apart more unlike: a drift, the motion prior's.
   kPerPose,      ///< They move more, as unlike at any lag: an error independent per pose.
 };

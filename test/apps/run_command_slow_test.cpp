@@ -26,6 +26,23 @@ using testing::CommandResult;
 using testing::RunCommandTest;
 using testing::runCurvesfm;
 
+nlohmann::json readReport(const std::string& out_dir) {
+  std::ifstream file(out_dir + "/report.json");
+  return nlohmann::json::parse(file);
+}
+
+struct RunWithReport {
+  CommandResult result;
+  nlohmann::json report;
+};
+
+// Runs `command --out out_dir`, expects it to succeed and reads its report.json.
+RunWithReport runWithReport(const std::string& command, const std::string& out_dir) {
+  CommandResult result = runCurvesfm(command + " --out " + out_dir);
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  return {result, readReport(out_dir)};
+}
+
 TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   const std::string dataset = writeShortPlanarDataset();
   const std::string out = path("planar_out");
@@ -46,8 +63,7 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
        {"curves.ply", "curves.obj", "curves.csv", "config.yaml", "overlays/000005.png"}) {
     EXPECT_TRUE(std::filesystem::exists(out + "/" + name)) << name;
   }
-  std::ifstream report_file(out + "/report.json");
-  const nlohmann::json report = nlohmann::json::parse(report_file);
+  const nlohmann::json report = readReport(out);
   EXPECT_EQ(report["curvesfm"], versionJson());
   EXPECT_EQ(report["options"]["progress_interval_s"], 0.0);
   EXPECT_EQ(report["counts"]["keyframes"], 6);
@@ -160,11 +176,7 @@ TEST_F(RunCommandTest, AReliftPassLiftsTheMapAtTheRefinedPosesAndStartsBaFromThe
   const std::string dataset = writeShortPlanarDataset();
   const std::string flags = shortPlanarFlags() + " --threads 1 --ba-motion-prior false";
   const auto runInto = [&](const std::string& out, const std::string& extra) {
-    const CommandResult r =
-        runCurvesfm("run --dataset " + dataset + " --out " + path(out) + flags + extra);
-    EXPECT_EQ(r.exit_code, 0) << r.output;
-    std::ifstream report_file(path(out + "/report.json"));
-    return std::make_pair(r, nlohmann::json::parse(report_file));
+    return runWithReport("run --dataset " + dataset + flags + extra, path(out));
   };
   const auto [first_output, first] = runInto("first", "");
   const auto [relift_output, relift] = runInto("relift", " --relift-passes 1");
@@ -203,11 +215,7 @@ TEST_F(RunCommandTest, AStartOffPerPoseIsLiftedAgainOnce) {
                             " --start-model-min-rotation-to-measurement 1e-12"
                             " --start-model-max-variogram-growth 1e12";
   const auto runInto = [&](const std::string& out, const std::string& extra) {
-    const CommandResult r =
-        runCurvesfm("run --dataset " + dataset + " --out " + path(out) + flags + extra);
-    EXPECT_EQ(r.exit_code, 0) << r.output;
-    std::ifstream report_file(path(out + "/report.json"));
-    return std::make_pair(r, nlohmann::json::parse(report_file));
+    return runWithReport("run --dataset " + dataset + flags + extra, path(out));
   };
   const auto [output, report] = runInto("per_pose", "");
   ASSERT_EQ(report["start_model"]["model"], "per_pose") << output.output;
@@ -231,8 +239,7 @@ TEST_F(RunCommandTest, FitChecksDropCurvesThatDoNotFitTheirViews) {
                   " --sanity-max-curve-residual 0.001 --sanity-min-chord-ratio 0.5");
   EXPECT_EQ(result.exit_code, 1) << result.output;
   EXPECT_THAT(result.output, HasSubstr("was implausible and dropped: nothing plausible"));
-  std::ifstream report_file(out + "/report.json");
-  const nlohmann::json report = nlohmann::json::parse(report_file);
+  const nlohmann::json report = readReport(out);
   const nlohmann::json& counts = report["sanity"]["counts"];
   EXPECT_GT(counts["checked"].get<int>(), 0);
   EXPECT_EQ(counts["high_residual"].get<int>() + counts["collapsed"].get<int>(),

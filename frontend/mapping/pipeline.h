@@ -144,10 +144,12 @@ struct PipelineOptions {
   /// (sigmas, as ba.kernel_width; 0: ba.kernel_width). Narrower, the final solve lets go of the
   /// wrong nearest edges that pull a good start away, and also of the observations a far start
   /// still has several pixels off: at 1 the truth starts of five of the six real sets drift 2-21 %
-  /// less, while Pavilion's initialiser start ends at 0.590 x instead of 0.562 and one of its
-  /// noise starts at 1.77 x instead of 1.21 (docs/benchmarks.md, "A narrower kernel for the last
-  /// global BA"). Off by default. Finite and > 0, or 0.
-  double last_global_ba_kernel_width = 0.0;
+  /// less and Pavilion's five noise starts, tied to their poses by the start model, end at
+  /// 0.38-0.47 x instead of 0.46-0.53, while Pavilion's initialiser start ends at 0.590 x
+  /// instead of 0.562 and the planar drift protocol is unchanged within its spread (45 of 45
+  /// cases refined; docs/benchmarks.md, "A narrower kernel for the last global BA" and "The
+  /// narrow last kernel by default"). Finite and > 0, or 0.
+  double last_global_ba_kernel_width = 1.0;
   /// Re-association leaves a keyframe's edges to the curves already observed there: a segment
   /// whose projection lies mostly (over half its samples) within explained_radius_px of the
   /// projection of a segment observed in that keyframe is not registered there, nor are two

@@ -338,7 +338,8 @@ TEST(Pipeline, RegistrationOnSeveralThreadsGivesTheSameRun) {
 // The global BA after the last re-association round weighs the edges with its own kernel width;
 // the BAs before it keep --ba-kernel-width, so the runs agree until that solve.
 TEST(Pipeline, TheLastGlobalBaTakesItsOwnKernelWidth) {
-  const PipelineResult same = runFiveFramesOneRound([](PipelineOptions*) {});
+  const PipelineResult same =
+      runFiveFramesOneRound([](PipelineOptions* o) { o->last_global_ba_kernel_width = 0.0; });
   const PipelineResult narrow =
       runFiveFramesOneRound([](PipelineOptions* o) { o->last_global_ba_kernel_width = 0.5; });
   ASSERT_FALSE(same.reassociation.empty());

@@ -80,7 +80,7 @@ TEST(PipelineOptions, ValidateChecksTheReassociationGates) {
 }
 
 TEST(PipelineOptions, TheLastGlobalBaKernelWidthIsZeroOrPositive) {
-  EXPECT_EQ(PipelineOptions{}.last_global_ba_kernel_width, 0.0);
+  EXPECT_EQ(PipelineOptions{}.last_global_ba_kernel_width, 1.0);
   for (const double width : {-1.0, std::numeric_limits<double>::infinity()}) {
     PipelineOptions options;
     options.last_global_ba_kernel_width = width;

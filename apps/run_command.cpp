@@ -737,7 +737,7 @@ std::optional<StartModelEstimate> readStartModel(const RunInput& input,
   if (e.model == StartModel::kPerPose && !ba->start_prior) {
     ba->motion_prior = false;
     ba->start_prior = true;
-    ba->start_prior_rotation_sigma_deg = options.prior_sigma_scale * e.rotation_rms_deg;
+    ba->start_prior_rotation_sigma_deg = options.rotation_prior_sigma_scale * e.rotation_rms_deg;
     // The centre's sigma is relative to the keyframes' spacing, which for every frame a keyframe
     // (the benches) is the frames' one measured here.
     ba->start_prior_centre_sigma_rel =
@@ -753,17 +753,24 @@ std::optional<StartModelEstimate> readStartModel(const RunInput& input,
   return e;
 }
 
-nlohmann::json startModelJson(const std::optional<StartModelEstimate>& e, bool switched) {
+nlohmann::json startModelJson(const std::optional<StartModelEstimate>& e, bool switched,
+                              const CurveBundleAdjustmentOptions& ba) {
   if (!e) return nullptr;
-  return {{"model", toString(e->model)},
-          {"frames_measured", e->frames_measured},
-          {"rotation_rms_deg", e->rotation_rms_deg},
-          {"centre_rms", e->centre_rms},
-          {"centre_rms_spacings", e->centre_rms_spacings},
-          {"rotation_to_measurement", e->rotation_to_measurement},
-          {"variogram_lag", e->variogram_lag},
-          {"variogram_growth", e->variogram_growth},
-          {"switched_to_start_prior", switched}};
+  nlohmann::json json = {{"model", toString(e->model)},
+                         {"frames_measured", e->frames_measured},
+                         {"rotation_rms_deg", e->rotation_rms_deg},
+                         {"centre_rms", e->centre_rms},
+                         {"centre_rms_spacings", e->centre_rms_spacings},
+                         {"rotation_to_measurement", e->rotation_to_measurement},
+                         {"variogram_lag", e->variogram_lag},
+                         {"variogram_growth", e->variogram_growth},
+                         {"switched_to_start_prior", switched}};
+  // The sigmas the switch gave the start prior, in --ba-start-prior-*'s units.
+  json["start_prior_rotation_sigma_deg"] =
+      switched ? nlohmann::json(ba.start_prior_rotation_sigma_deg) : nlohmann::json(nullptr);
+  json["start_prior_centre_sigma_spacings"] =
+      switched ? nlohmann::json(ba.start_prior_centre_sigma_rel) : nlohmann::json(nullptr);
+  return json;
 }
 
 bool globalBaUsable(const ScheduleReport& report) {
@@ -1014,7 +1021,7 @@ int RunCommand::run() const {
        {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
                                             : nlohmann::json(nullptr)},
        {"camera", cameraToJson(pipeline->undistortedCamera())},
-       {"start_model", startModelJson(start_model, per_pose_start)},
+       {"start_model", startModelJson(start_model, per_pose_start, options.ba)},
        {"relift_passes_run", relift_passes},
        {"scene_scale", result.scene_scale},
        {"counts",

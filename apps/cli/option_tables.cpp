@@ -443,7 +443,10 @@ void addStartModelOptions(OptionsTable* table, StartModelOptions* o, const std::
               "Above min-rotation, the start is off per pose when the variogram grows at most "
               "this much from lag 1 to that lag (else it drifts)")
       .number("prior_sigma_scale", "prior-sigma-scale", &o->prior_sigma_scale,
-              "A start off per pose is tied to its poses at this times the measured noise")
+              "A start off per pose is tied to its centres at this times the measured noise")
+      .number("rotation_prior_sigma_scale", "rotation-prior-sigma-scale",
+              &o->rotation_prior_sigma_scale,
+              "... and to its orientations at this times the measured rotation noise")
       .number("relift_passes", "relift-passes", &o->relift_passes,
               "A start off per pose is lifted again at the refined poses this many times (at "
               "least: --relift-passes may ask more)")

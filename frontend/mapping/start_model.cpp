@@ -23,6 +23,8 @@ void StartModelOptions::validate() const {
   require.positive("max_variogram_growth", max_variogram_growth);
   require(prior_sigma_scale > 0.0 && prior_sigma_scale <= 10.0, "prior_sigma_scale",
           prior_sigma_scale, "in (0, 10]");
+  require(rotation_prior_sigma_scale > 0.0 && rotation_prior_sigma_scale <= 100.0,
+          "rotation_prior_sigma_scale", rotation_prior_sigma_scale, "in (0, 100]");
   require.positive("max_reprojection_error_px", max_reprojection_error_px);
   require(relift_passes >= 0 && relift_passes <= 100, "relift_passes", relift_passes,
           "in [0, 100]");

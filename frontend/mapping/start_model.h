@@ -47,8 +47,8 @@ struct EnumNames<StartModel> {
 /// start, CurveBundleAdjustmentOptions::start_prior, instead of the motion prior).
 struct StartModelOptions {
   /// Measure the start and, when it is off per pose, switch the BA from the motion prior to the
-  /// start prior at prior_sigma_scale times the measured sigmas (run only, with given initial
-  /// poses; an explicit --ba-start-prior keeps its own sigmas).
+  /// start prior at rotation_prior_sigma_scale and prior_sigma_scale times the measured sigmas
+  /// (run only, with given initial poses; an explicit --ba-start-prior keeps its own sigmas).
   bool from_images = true;
   /// A frame is measured only if it sees at least this many of the points (count). >= 6.
   int min_points = 30;
@@ -79,12 +79,20 @@ struct StartModelOptions {
   /// 0.85-1.46 for noise applied per pose (Pavilion, KITTI 06, planar scenes), 1.7-5.6 for the
   /// planar drift starts and 7-Scenes' ground truth (docs/benchmarks.md). Finite, > 0.
   double max_variogram_growth = 1.6;
-  /// A start off per pose is tied to each of its poses with std devs of this times the measured
-  /// rotation and centre noise (unitless): the edge term counts each segment's shared error once
-  /// per sample, so a prior at the true noise loses to it, as the motion prior's sigmas are the
-  /// drift's over 2.5 (CurveBundleAdjustmentOptions). Pavilion noise seed 1, refined / start at
-  /// 1 / 0.4 of the measured sigmas: 0.99 / 0.65 x (docs/benchmarks.md). In (0, 10].
+  /// A start off per pose is tied to each of its centres with std devs of this times the measured
+  /// centre noise (unitless): the edge term counts each segment's shared error once per sample,
+  /// so a prior at the true noise loses to it, as the motion prior's sigmas are the drift's over
+  /// 2.5 (CurveBundleAdjustmentOptions). Pavilion noise seed 1, refined / start at 1 / 0.4 of the
+  /// measured sigmas: 0.99 / 0.65 x (docs/benchmarks.md). In (0, 10].
   double prior_sigma_scale = 0.4;
+  /// ... and to each of its orientations with std devs of this times the measured rotation noise
+  /// (unitless). The curves measure a view's rotation far better than its centre: a prior that
+  /// holds the rotations near their noisy start makes the BA fit the images by moving the centres
+  /// instead (a planar start off by 0.1 deg and exact in its centres ended 0.14 mm off at 0.4 x).
+  /// At 1.5 rather than 0.4: the planar per-pose starts 0.26-0.53 x against 0.41-1.74,
+  /// KITTI 06's five noise starts median 0.57 against 0.59, Pavilion's median 0.43 against 0.42
+  /// (docs/benchmarks.md, "The rotation prior of a per-pose start"). In (0, 100].
+  double rotation_prior_sigma_scale = 1.5;
   /// A start off per pose runs the pipeline this many more times (at least; --relift-passes may
   /// ask more), each lifting and registering the map again at the previous pass's refined poses
   /// under the same start prior: the map lifted at the noisy start holds its noise, one lifted at

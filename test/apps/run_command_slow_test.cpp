@@ -12,6 +12,7 @@
 
 #include "apps/cli/report_json.h"
 #include "core/dataset_io.h"
+#include "frontend/mapping/start_model.h"
 #include "test/apps/run_command_fixture.h"
 #include "test/support/run_executable.h"
 
@@ -217,9 +218,16 @@ TEST_F(RunCommandTest, AStartOffPerPoseIsLiftedAgainOnce) {
   const auto runInto = [&](const std::string& out, const std::string& extra) {
     return runWithReport("run --dataset " + dataset + flags + extra, path(out));
   };
-  const auto [output, report] = runInto("per_pose", "");
-  ASSERT_EQ(report["start_model"]["model"], "per_pose") << output.output;
-  EXPECT_TRUE(report["start_model"]["switched_to_start_prior"].get<bool>());
+  const auto [output, report] = runInto("per_pose", " --start-model-rotation-prior-sigma-scale 3");
+  const nlohmann::json& model = report["start_model"];
+  ASSERT_EQ(model["model"], "per_pose") << output.output;
+  EXPECT_TRUE(model["switched_to_start_prior"].get<bool>());
+  // Each sigma is its own scale times what was measured.
+  EXPECT_DOUBLE_EQ(model["start_prior_rotation_sigma_deg"].get<double>(),
+                   3.0 * model["rotation_rms_deg"].get<double>());
+  EXPECT_DOUBLE_EQ(
+      model["start_prior_centre_sigma_spacings"].get<double>(),
+      StartModelOptions{}.prior_sigma_scale * model["centre_rms_spacings"].get<double>());
   EXPECT_EQ(report["relift_passes_run"], 1);
   EXPECT_THAT(output.output, HasSubstr("relift 1 of 1: lifting the curves again"));
 

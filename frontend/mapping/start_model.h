@@ -67,9 +67,9 @@ struct StartModelOptions {
   /// 1.4 x on Pavilion and 1.6-1.7 x on the planar logos, whose 0.1 deg per-pose noise measures
   /// 1.6-3.0 x: there the images cannot tell the two apart, and the errors cost unequally. A
   /// start off per pose read as consistent keeps the motion prior and ends 2.8-4.8 x farther off
-  /// than it started, read as per pose 0.6-1.7 x; a drift read as per pose still ends 0.37 x
-  /// (opencv-logo; 0.15 x as consistent), a true start 0.02 mm off instead of 0.01
-  /// (docs/benchmarks.md, session 34). Finite, > 0.
+  /// than it started, read as per pose 0.6-1.7 x (0.3-0.5 x with session 35's rotation prior); a
+  /// drift read as per pose still ends 0.37 x (opencv-logo; 0.15 x as consistent), a true start
+  /// 0.02 mm off instead of 0.01 (docs/benchmarks.md, session 34). Finite, > 0.
   double min_rotation_to_measurement = 1.5;
   /// The variogram is read at lags 1 and k = min(this, measured frames / 3) (frames). In [2, 100].
   int max_variogram_lag = 8;

@@ -29,8 +29,7 @@ TEST_F(InitCommandTest, ATexturelessSequenceSaysWhyInOneLineAndExitsOne) {
   EXPECT_THAT(result.output, HasSubstr("not registered, no_model: frames 0-2"));
   EXPECT_THAT(result.output, HasSubstr("init: nothing reconstructed: no initial pair"));
   // The report still says what happened to every frame.
-  std::ifstream in(path("out/report.json"));
-  const nlohmann::json report = nlohmann::json::parse(in);
+  const nlohmann::json report = testing::readReport(path("out"));
   EXPECT_EQ(report["counts"]["registered"], 0);
   EXPECT_EQ(report["frames"].size(), 3u);
   EXPECT_EQ(report["frames"][0]["status"], "no_model");

@@ -21,6 +21,12 @@
 namespace curvesfm {
 namespace testing {
 
+// The report.json a command wrote into `out_dir`.
+inline nlohmann::json readReport(const std::string& out_dir) {
+  std::ifstream file(out_dir + "/report.json");
+  return nlohmann::json::parse(file);
+}
+
 // Rings and bars of several colours on a grey ground: curved and straight edges in every
 // direction for the planar views.
 inline cv::Mat ringsTexture() {

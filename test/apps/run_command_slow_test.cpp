@@ -24,13 +24,9 @@ using ::testing::Not;
 using ::testing::StartsWith;
 
 using testing::CommandResult;
+using testing::readReport;
 using testing::RunCommandTest;
 using testing::runCurvesfm;
-
-nlohmann::json readReport(const std::string& out_dir) {
-  std::ifstream file(out_dir + "/report.json");
-  return nlohmann::json::parse(file);
-}
 
 struct RunWithReport {
   CommandResult result;

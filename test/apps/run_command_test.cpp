@@ -27,6 +27,7 @@ using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
 using testing::CommandResult;
+using testing::readReport;
 using testing::ringsTexture;
 using testing::RunCommandTest;
 using testing::runCurvesfm;
@@ -186,8 +187,7 @@ TEST_F(RunCommandTest, OverlaysColourTheCurvesAndDrawTheWorstOnesUnderTheirDocum
                   " --overlays --overlay-colour-by track" + shortPlanarFlags());
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_THAT(result.output, HasSubstr(", overlays/, worst_curves/)"));
-  std::ifstream report_file(out + "/report.json");
-  const nlohmann::json report = nlohmann::json::parse(report_file);
+  const nlohmann::json report = readReport(out);
   EXPECT_EQ(report["options"]["overlay"]["colour_by"], "track");
   EXPECT_TRUE(std::filesystem::exists(out + "/overlays/000005.png"));
   // Each worst curve drawn on its worst keyframe, under the name the README gives, and indexed.

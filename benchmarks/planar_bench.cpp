@@ -44,6 +44,7 @@
 #include "apps/cli/option_tables.h"
 #include "apps/cli/plot_scripts.h"
 #include "benchmarks/support/bench_common.h"
+#include "benchmarks/support/planar_photos.h"
 #include "core/errors.h"
 #include "core/trajectory_evaluation.h"
 #include "frontend/mapping/pipeline.h"
@@ -52,18 +53,8 @@
 namespace curvesfm {
 namespace {
 
-struct Photo {
-  std::string file;
-  std::string category;  ///< "logo", "indoor" or "outdoor".
-};
-
-// The paper took its indoor images from TUM RGB-D and its outdoor ones from KITTI; OpenCV's
-// sample data has no such frames, so these are the closest in kind: flat logos with few
-// contours, cluttered rooms, and street scenes / facades.
-const std::vector<Photo> kPhotos = {
-    {"opencv-logo.png", "logo"}, {"LinuxLogo.jpg", "logo"},      {"WindowsLogo.jpg", "logo"},
-    {"left01.jpg", "indoor"},    {"rubberwhale1.png", "indoor"}, {"box_in_scene.png", "indoor"},
-    {"building.jpg", "outdoor"}, {"leuvenA.jpg", "outdoor"},     {"graf1.png", "outdoor"}};
+using Photo = bench::PlanarPhoto;
+const std::vector<Photo>& kPhotos = bench::planarPhotos();
 const std::vector<int> kNoisePercents = {0, 5, 10, 15, 20};
 
 // The paper's Table 2 ("average position error of our method", converted from m to mm): rows
@@ -74,7 +65,7 @@ const std::array<std::array<double, 5>, 4> kPaperTable2Mm = {{{0.415, 0.312, 0.4
                                                               {0.611, 0.798, 0.812, 3.0, 7.5}}};
 
 struct BenchOptions {
-  std::string data_dir = "/usr/share/doc/opencv-doc/examples/data";  ///< Folder of the photos.
+  std::string data_dir = bench::kOpenCvSampleData;                   ///< Folder of the photos.
   std::string out = "bench_out/planar";                              ///< Output folder (created).
   int frames = 30;  ///< Rendered views per case; >= 3.
   // The initial pose error; sim/planar_scene.h's defaults, as `curvesfm synth planar`.

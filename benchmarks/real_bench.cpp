@@ -1,8 +1,10 @@
 // real_bench: the real image sets of the data folder through the initialiser, the curve pipeline,
 // hybrid BA and COLMAP, side by side, evaluated by one code against each set's ground truth.
 //
-// For every set of kSets found under --data (a missing one is skipped with a note) and every
-// variant of --variants:
+// For every set of kSets found under --data (a missing one is skipped with a note; --sets picks
+// some, or none), every photo of --planar-photos rendered by `curvesfm synth planar` as the set
+// planar_<name> (the paper's orbit over it, no initial poses), and every folder of --extra-sets
+// (any layout `curvesfm run` reads, with ground truth), and every variant of --variants:
 //   init    `curvesfm init --dataset SET --out ...`: the point initialiser alone;
 //   curves  `curvesfm run --dataset SET --out ...`: with no initial poses, run starts with the
 //           point initialiser and refines its poses with the curve pipeline;
@@ -60,6 +62,7 @@
 
 #include "apps/cli/plot_scripts.h"
 #include "benchmarks/support/bench_common.h"
+#include "benchmarks/support/planar_photos.h"
 #include "benchmarks/support/subprocess.h"
 #include "core/angles.h"
 #include "core/colmap_model.h"
@@ -117,6 +120,14 @@ struct BenchOptions {
   std::string out = "bench_out/real";   ///< Output folder (created).
   std::string curvesfm = CURVESFM_EXECUTABLE;         ///< The curvesfm executable.
   std::vector<std::string> sets;                      ///< Names of kSets to run; empty: all.
+  bool no_builtin_sets = false;                       ///< --sets none: only the sets below.
+  /// Dataset folders run beside kSets (any layout `curvesfm run` reads, with ground truth), each
+  /// named by its folder.
+  std::vector<std::string> extra_sets;
+  /// Photos of --planar-dir rendered by `curvesfm synth planar` (its defaults, no initial poses)
+  /// into OUT/planar_sets/STEM and run as the set planar_STEM.
+  std::vector<std::string> planar_photos;
+  std::string planar_dir = bench::kOpenCvSampleData;  ///< Folder of --planar-photos.
   std::vector<std::string> variants = kVariantNames;  ///< Variants to run, in this order.
   std::string hybrid_flags = "--ba-points true";      ///< Extra flags of the hybrid variant.
   int max_frames = 0;  ///< Frame cap for every set (0: each set's own cap).
@@ -903,13 +914,13 @@ void checkMapAt(const BenchOptions& options) {
   }
 }
 
-int run(const BenchOptions& options, const std::string& command) {
-  const Clock::time_point start = Clock::now();
-  checkMapAt(options);
+// The sets of kSets that --sets selects and --data holds.
+std::vector<RealSet> builtInSets(const BenchOptions& options) {
+  std::vector<RealSet> sets;
+  if (options.no_builtin_sets) return sets;
   if (!fs::is_directory(options.data)) {
     throw IoError(options.data, "no such folder (--data: the folder of the real sets)");
   }
-  std::vector<RealSet> sets;
   for (const RealSet& set : kSets) {
     if (!options.sets.empty() &&
         std::find(options.sets.begin(), options.sets.end(), set.name) == options.sets.end()) {
@@ -922,9 +933,77 @@ int run(const BenchOptions& options, const std::string& command) {
     }
     sets.push_back(set);
   }
-  if (sets.empty()) throw IoError(options.data, "none of the benchmark's sets is there");
+  return sets;
+}
+
+// Renders every --planar-photos photo as a planar sequence below `out` (curvesfm synth planar:
+// the paper's orbit over the photo, its ground truth, and no initial poses, so that an init start
+// runs the point initialiser) and returns them as sets.
+std::vector<RealSet> planarSets(const BenchOptions& options, const fs::path& out) {
+  std::vector<RealSet> sets;
+  for (const std::string& photo : options.planar_photos) {
+    const fs::path image = fs::path(options.planar_dir) / photo;
+    if (!fs::is_regular_file(image))
+      throw IoError(image.string(), "no such photo (--planar-photos)");
+    const fs::path dir = fs::absolute(out / "planar_sets" / fs::path(photo).stem());
+    fs::remove_all(dir);
+    const fs::path log = out / ("planar_sets_" + fs::path(photo).stem().string() + ".log");
+    const bench::ProcessResult r =
+        bench::runProcess({options.curvesfm, "synth", "planar", "--image", image.string(), "--out",
+                           dir.string(), "--init-poses", "false"},
+                          log.string(), log.string());
+    if (r.exit_code != 0) {
+      throw Error("real_bench: curvesfm synth planar --image " + image.string() +
+                  " failed (exit code " + std::to_string(r.exit_code) +
+                  "): " + bench::lastLine(log.string()));
+    }
+    sets.push_back({"planar_" + fs::path(photo).stem().string(), dir.string(), "", 0, 1,
+                    "rendered from " + photo + " by curvesfm synth planar (its defaults)"});
+  }
+  return sets;
+}
+
+// --extra-sets as sets, each named by its folder.
+std::vector<RealSet> extraSets(const BenchOptions& options) {
+  std::vector<RealSet> sets;
+  for (const std::string& folder : options.extra_sets) {
+    const fs::path dir = fs::absolute(folder).lexically_normal();
+    if (!fs::is_directory(dir)) throw IoError(folder, "no such folder (--extra-sets)");
+    const fs::path name = dir.has_filename() ? dir.filename() : dir.parent_path().filename();
+    sets.push_back({name.string(), dir.string(), "", 0, 1, "given by --extra-sets " + folder});
+  }
+  return sets;
+}
+
+// Every set of the run: kSets, then the planar renders, then --extra-sets; names must differ,
+// since each names its output folder.
+std::vector<RealSet> selectedSets(const BenchOptions& options, const fs::path& out) {
+  std::vector<RealSet> sets = builtInSets(options);
+  for (const std::vector<RealSet>& more : {planarSets(options, out), extraSets(options)}) {
+    sets.insert(sets.end(), more.begin(), more.end());
+  }
+  std::set<std::string> names;
+  for (const RealSet& set : sets) {
+    if (!names.insert(set.name).second) {
+      throw InvalidOptions("BenchOptions", "extra_sets", set.name,
+                           "two sets named " + set.name + ": each names its output folder")
+          .withFlag("extra-sets");
+    }
+  }
+  return sets;
+}
+
+int run(const BenchOptions& options, const std::string& command) {
+  const Clock::time_point start = Clock::now();
+  checkMapAt(options);
   const fs::path out(options.out);
   fs::create_directories(out);
+  const std::vector<RealSet> sets = selectedSets(options, out);
+  if (sets.empty()) {
+    throw IoError(options.data,
+                  "none of the benchmark's sets is there, and no --planar-photos or "
+                  "--extra-sets given");
+  }
   // COLMAP's GUI library needs a display unless Qt draws off-screen.
   setenv("QT_QPA_PLATFORM", "offscreen", 0);
   const std::vector<Variant> variants = selectedVariants(options);
@@ -1063,6 +1142,11 @@ int main(int argc, char** argv) {
          "--sets",
          [&options](const std::string& list) {
            options.sets = curvesfm::bench::splitAtCommas(list, "--sets");
+           options.no_builtin_sets = options.sets == std::vector<std::string>{"none"};
+           if (options.no_builtin_sets || options.sets == std::vector<std::string>{"all"}) {
+             options.sets.clear();
+             return;
+           }
            for (const std::string& name : options.sets) {
              const auto known = [&](const curvesfm::RealSet& s) { return s.name == name; };
              if (std::none_of(curvesfm::kSets.begin(), curvesfm::kSets.end(), known)) {
@@ -1071,8 +1155,34 @@ int main(int argc, char** argv) {
              }
            }
          },
-         "Comma-separated set names to run, or all")
+         "Comma-separated set names to run, all, or none (only --planar-photos and "
+         "--extra-sets)")
       ->default_str("all");
+  app.add_option_function<std::string>(
+         "--extra-sets",
+         [&options](const std::string& list) {
+           options.extra_sets = curvesfm::bench::splitAtCommas(list, "--extra-sets");
+         },
+         "Comma-separated dataset folders to run beside the sets of --data (any layout curvesfm "
+         "run reads, with ground truth; each named by its folder, its init start the folder's "
+         "init_poses.txt when it has one)")
+      ->default_str("");
+  app.add_option_function<std::string>(
+         "--planar-photos",
+         [&options](const std::string& list) {
+           options.planar_photos = curvesfm::bench::splitAtCommas(list, "--planar-photos");
+           if (options.planar_photos == std::vector<std::string>{"all"}) {
+             options.planar_photos.clear();
+             for (const auto& photo : curvesfm::bench::planarPhotos()) {
+               options.planar_photos.push_back(photo.file);
+             }
+           }
+         },
+         "Comma-separated photos of --planar-dir (or all: planar_bench's nine), each rendered "
+         "by curvesfm synth planar into OUT/planar_sets and run as the set planar_<name>")
+      ->default_str("");
+  app.add_option("--planar-dir", options.planar_dir, "Folder of --planar-photos")
+      ->capture_default_str();
   app.add_option_function<std::string>(
          "--variants",
          [&options](const std::string& list) {

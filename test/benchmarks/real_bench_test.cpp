@@ -1,8 +1,10 @@
-// real_bench's command line: a bad set or variant name and a missing data folder end in one
-// message naming the flag or folder and a non-zero exit, before anything runs.
+// real_bench's command line: a bad set or variant name, a missing data folder, photo or extra
+// set, and two sets of one name end in one message naming the flag, file or folder and a
+// non-zero exit, before anything runs.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "test/support/run_executable.h"
@@ -41,6 +43,41 @@ TEST(RealBenchCommandLine, NamesADataFolderWithoutTheSets) {
   const testing::CommandResult r = runRealBench("--data " + ::testing::TempDir() + " --out " + out);
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_THAT(r.output, HasSubstr("none of the benchmark's sets is there"));
+}
+
+TEST(RealBenchCommandLine, NamesAMissingExtraSet) {
+  const std::string out = ::testing::TempDir() + "real_bench_no_extra";
+  const testing::CommandResult r =
+      runRealBench("--sets none --extra-sets /nonexistent/my_sequence --out " + out);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("/nonexistent/my_sequence: no such folder (--extra-sets)"));
+}
+
+TEST(RealBenchCommandLine, RefusesTwoSetsOfOneName) {
+  const std::string root = ::testing::TempDir() + "real_bench_twins";
+  std::filesystem::create_directories(root + "/a/walk");
+  std::filesystem::create_directories(root + "/b/walk");
+  const testing::CommandResult r = runRealBench("--sets none --extra-sets " + root + "/a/walk," +
+                                                root + "/b/walk --out " + root + "/out");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("two sets named walk"));
+}
+
+TEST(RealBenchCommandLine, NamesAMissingPlanarPhoto) {
+  const std::string out = ::testing::TempDir() + "real_bench_no_photo";
+  const testing::CommandResult r = runRealBench(
+      "--sets none --planar-dir /nonexistent/photos "
+      "--planar-photos left01.jpg --out " +
+      out);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("/nonexistent/photos/left01.jpg: no such photo"));
+}
+
+TEST(RealBenchCommandLine, NamesNoSetToRun) {
+  const std::string out = ::testing::TempDir() + "real_bench_none";
+  const testing::CommandResult r = runRealBench("--sets none --out " + out);
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("no --planar-photos or --extra-sets given"));
 }
 
 TEST(RealBenchCommandLine, RejectsAStartOriginOtherThanNativeOrFirst) {

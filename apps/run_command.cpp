@@ -734,7 +734,7 @@ std::optional<StartModelEstimate> readStartModel(const RunInput& input,
       "to %d)",
       toString(e.model).c_str(), e.frames_measured, e.rotation_rms_deg, e.rotation_to_measurement,
       e.centre_rms_spacings, e.variogram_growth, e.variogram_lag);
-  if (e.model == StartModel::kPerPose && !ba->start_prior) {
+  if (tiesEachPose(e, options) && !ba->start_prior) {
     ba->motion_prior = false;
     ba->start_prior = true;
     ba->start_prior_rotation_sigma_deg = options.rotation_prior_sigma_scale * e.rotation_rms_deg;
@@ -957,9 +957,8 @@ int RunCommand::run() const {
   options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
   std::unique_ptr<Pipeline> pipeline;
   PipelineResult result;
-  const bool per_pose_start = options.ba.start_prior && !options_.ba.start_prior;
-  const int relift_passes =
-      std::max(relift_passes_, per_pose_start ? start_model_.relift_passes : 0);
+  const bool tied_start = options.ba.start_prior && !options_.ba.start_prior;
+  const int relift_passes = std::max(relift_passes_, tied_start ? start_model_.relift_passes : 0);
   std::vector<Pose3> frontend_poses = input.frontend_poses;
   double image_wait_seconds = 0.0;
   for (int pass = 0; pass <= relift_passes; ++pass) {
@@ -1021,7 +1020,7 @@ int RunCommand::run() const {
        {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
                                             : nlohmann::json(nullptr)},
        {"camera", cameraToJson(pipeline->undistortedCamera())},
-       {"start_model", startModelJson(start_model, per_pose_start, options.ba)},
+       {"start_model", startModelJson(start_model, tied_start, options.ba)},
        {"relift_passes_run", relift_passes},
        {"scene_scale", result.scene_scale},
        {"counts",

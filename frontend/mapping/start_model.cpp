@@ -177,4 +177,9 @@ StartModelEstimate estimateStartModel(const Camera& camera, const PointInitialis
   return estimate;
 }
 
+bool tiesEachPose(const StartModelEstimate& estimate, const StartModelOptions& options) {
+  return estimate.model == StartModel::kPerPose ||
+         (estimate.model == StartModel::kDrifting && options.tie_drifting_per_pose);
+}
+
 }  // namespace curvesfm

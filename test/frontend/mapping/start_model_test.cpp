@@ -110,6 +110,22 @@ TEST(StartModel, ADriftingStartIsNotCalledPerPose) {
   EXPECT_NE(e.model, StartModel::kNotMeasured);
 }
 
+TEST(StartModel, EveryStartThatMovesIsTiedPerPoseUnlessADriftIsLeftToTheMotionPrior) {
+  StartModelOptions o;
+  StartModelEstimate e;
+  const auto ties = [&](StartModel model) {
+    e.model = model;
+    return tiesEachPose(e, o);
+  };
+  EXPECT_TRUE(ties(StartModel::kPerPose));
+  EXPECT_TRUE(ties(StartModel::kDrifting));
+  EXPECT_FALSE(ties(StartModel::kConsistent));
+  EXPECT_FALSE(ties(StartModel::kNotMeasured));
+  o.tie_drifting_per_pose = false;
+  EXPECT_TRUE(ties(StartModel::kPerPose));
+  EXPECT_FALSE(ties(StartModel::kDrifting));
+}
+
 TEST(StartModel, TooFewFramesGiveNoVerdict) {
   const PointScene s = scene();
   StartModelOptions o;

@@ -427,7 +427,7 @@ void addStartModelOptions(OptionsTable* table, StartModelOptions* o, const std::
   table->group(o, "StartModelOptions", path, "start-model-", "Start model")
       .boolean("from_images", "from-images", &o->from_images,
                "With given initial poses, register each frame again on the points triangulated "
-               "at them; when the poses move against them (per pose, or drifting with "
+               "at them; when the frames move against the points (per pose, or drifting with "
                "tie-drifting-per-pose), tie each keyframe to its start (start prior, at the "
                "sigma scales times the measured sigmas) instead of each motion to the start's")
       .number("min_points", "min-points", &o->min_points, "Points a measured frame sees at least")
@@ -448,7 +448,7 @@ void addStartModelOptions(OptionsTable* table, StartModelOptions* o, const std::
               &o->rotation_prior_sigma_scale,
               "... and to its orientations at this times the measured rotation noise")
       .number("relift_passes", "relift-passes", &o->relift_passes,
-              "A start off per pose is lifted again at the refined poses this many times (at "
+              "A start tied per pose is lifted again at the refined poses this many times (at "
               "least: --relift-passes may ask more)")
       .boolean("tie_drifting_per_pose", "tie-drifting-per-pose", &o->tie_drifting_per_pose,
                "A start read as drifting is tied to each pose and lifted again as a per-pose one "

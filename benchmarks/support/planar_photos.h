@@ -19,9 +19,9 @@ struct PlanarPhoto {
 /// street scenes / facades. planar_bench runs them; real_bench renders them as sets.
 inline const std::vector<PlanarPhoto>& planarPhotos() {
   static const std::vector<PlanarPhoto> photos = {
-      {"opencv-logo.png", "logo"},   {"LinuxLogo.jpg", "logo"},       {"WindowsLogo.jpg", "logo"},
-      {"left01.jpg", "indoor"},      {"rubberwhale1.png", "indoor"},  {"box_in_scene.png", "indoor"},
-      {"building.jpg", "outdoor"},   {"leuvenA.jpg", "outdoor"},      {"graf1.png", "outdoor"}};
+      {"opencv-logo.png", "logo"}, {"LinuxLogo.jpg", "logo"},      {"WindowsLogo.jpg", "logo"},
+      {"left01.jpg", "indoor"},    {"rubberwhale1.png", "indoor"}, {"box_in_scene.png", "indoor"},
+      {"building.jpg", "outdoor"}, {"leuvenA.jpg", "outdoor"},     {"graf1.png", "outdoor"}};
   return photos;
 }
 

@@ -47,8 +47,8 @@ struct EnumNames<StartModel> {
   }};
 };
 
-/// When estimateStartModel() calls a start per-pose (and the run then ties each keyframe to its
-/// start, CurveBundleAdjustmentOptions::start_prior, instead of the motion prior).
+/// What estimateStartModel() calls a start, and which verdicts make the run tie each keyframe to
+/// its start (CurveBundleAdjustmentOptions::start_prior) instead of using the motion prior.
 struct StartModelOptions {
   /// Measure the start and, when it moves against the images (tiesEachPose), switch the BA from
   /// the motion prior to the start prior at rotation_prior_sigma_scale and prior_sigma_scale times
@@ -70,7 +70,7 @@ struct StartModelOptions {
   /// (from its inliers' reprojection scatter; unitless, RMS over the frames): 1 is a start whose
   /// moves are the measurement's noise alone. True starts measure 1.0-1.7 x on the planar scenes
   /// and 1.4 x on Pavilion, noise of 0.1 deg per pose 1.2-5.5 x (the logos, whose few corners
-  /// measure poorly, 1.2-2.3 x): the images cannot tell the two apart there, and the errors cost
+  /// measure poorly, 1.2-3.3 x): the images cannot tell the two apart there, and the errors cost
   /// unequally. A start off per pose read as consistent keeps the motion prior and ends 3-5 x
   /// farther off than it started (LinuxLogo 3.7 x, tied per pose 0.53 x), a true start tied per
   /// pose drifts 0.01-0.07 mm instead of 0.01-0.04 on the planar scenes (docs/benchmarks.md,
@@ -98,7 +98,7 @@ struct StartModelOptions {
   /// KITTI 06's five noise starts median 0.57 against 0.59, Pavilion's median 0.43 against 0.42
   /// (docs/benchmarks.md, "The rotation prior of a per-pose start"). In (0, 100].
   double rotation_prior_sigma_scale = 1.5;
-  /// A start off per pose runs the pipeline this many more times (at least; --relift-passes may
+  /// A start tied per pose runs the pipeline this many more times (at least; --relift-passes may
   /// ask more), each lifting and registering the map again at the previous pass's refined poses
   /// under the same start prior: the map lifted at the noisy start holds its noise, one lifted at
   /// better poses gives better poses. Refined / start, one pass against none, noise seeds 1-3:

@@ -232,6 +232,33 @@ TEST_F(RunCommandTest, AStartOffPerPoseIsLiftedAgainOnce) {
   EXPECT_THAT(none_output.output, Not(HasSubstr("relift 1 of")));
 }
 
+// A start read as drifting is tied per pose too unless --start-model-tie-drifting-per-pose false
+// leaves it to the motion prior. As above, the thresholds are set so that any measured start of
+// the short sequence is read as drifting.
+TEST_F(RunCommandTest, ADriftingStartIsTiedPerPoseUnlessLeftToTheMotionPrior) {
+  const std::string dataset = writeShortPlanarDataset();
+  const std::string flags = shortPlanarFlags() +
+                            " --threads 1 --start-model-min-frames 3 --start-model-min-points 6"
+                            " --start-model-min-rotation 1e-12"
+                            " --start-model-min-rotation-to-measurement 1e-12"
+                            " --start-model-max-variogram-growth 1e-12"
+                            " --start-model-relift-passes 0";
+  const auto runInto = [&](const std::string& out, const std::string& extra) {
+    return runWithReport("run --dataset " + dataset + flags + extra, path(out));
+  };
+  const auto [tied_output, tied] = runInto("tied", "");
+  ASSERT_EQ(tied["start_model"]["model"], "drifting") << tied_output.output;
+  EXPECT_TRUE(tied["start_model"]["switched_to_start_prior"].get<bool>());
+  EXPECT_GT(tied["start_model"]["start_prior_rotation_sigma_deg"].get<double>(), 0.0);
+  EXPECT_THAT(tied_output.output, HasSubstr("the BA ties each keyframe to its start"));
+
+  const auto [kept_output, kept] = runInto("kept", " --start-model-tie-drifting-per-pose false");
+  ASSERT_EQ(kept["start_model"]["model"], "drifting") << kept_output.output;
+  EXPECT_FALSE(kept["start_model"]["switched_to_start_prior"].get<bool>());
+  EXPECT_TRUE(kept["start_model"]["start_prior_rotation_sigma_deg"].is_null());
+  EXPECT_THAT(kept_output.output, Not(HasSubstr("the BA ties each keyframe to its start")));
+}
+
 // The fit checks after global BA: with a residual bound no curve meets, every curve of the global
 // map is found implausible for its residual, dropped and counted under its reason, and a run
 // left with nothing plausible says so and fails.

@@ -201,16 +201,21 @@ TEST_F(RunCommandTest, AReliftPassLiftsTheMapAtTheRefinedPosesAndStartsBaFromThe
   }
 }
 
+// Start-model thresholds under which any measured start of the short sequence moves: with
+// `max_growth` 1e12 it is read as per pose, with 1e-12 as drifting.
+std::string verdictOnAnyStart(const std::string& max_growth) {
+  return " --threads 1 --start-model-min-frames 3 --start-model-min-points 6"
+         " --start-model-min-rotation 1e-12 --start-model-min-rotation-to-measurement 1e-12"
+         " --start-model-max-variogram-growth " +
+         max_growth;
+}
+
 // A start the images read as off per pose is lifted again once by default. The short sequence is
 // too short for a verdict under the defaults, so the test lowers every threshold until any
 // measured start is per pose: what it checks is the run's response to that verdict.
 TEST_F(RunCommandTest, AStartOffPerPoseIsLiftedAgainOnce) {
   const std::string dataset = writeShortPlanarDataset();
-  const std::string flags = shortPlanarFlags() +
-                            " --threads 1 --start-model-min-frames 3 --start-model-min-points 6"
-                            " --start-model-min-rotation 1e-12"
-                            " --start-model-min-rotation-to-measurement 1e-12"
-                            " --start-model-max-variogram-growth 1e12";
+  const std::string flags = shortPlanarFlags() + verdictOnAnyStart("1e12");
   const auto runInto = [&](const std::string& out, const std::string& extra) {
     return runWithReport("run --dataset " + dataset + flags + extra, path(out));
   };
@@ -237,12 +242,8 @@ TEST_F(RunCommandTest, AStartOffPerPoseIsLiftedAgainOnce) {
 // the short sequence is read as drifting.
 TEST_F(RunCommandTest, ADriftingStartIsTiedPerPoseUnlessLeftToTheMotionPrior) {
   const std::string dataset = writeShortPlanarDataset();
-  const std::string flags = shortPlanarFlags() +
-                            " --threads 1 --start-model-min-frames 3 --start-model-min-points 6"
-                            " --start-model-min-rotation 1e-12"
-                            " --start-model-min-rotation-to-measurement 1e-12"
-                            " --start-model-max-variogram-growth 1e-12"
-                            " --start-model-relift-passes 0";
+  const std::string flags =
+      shortPlanarFlags() + verdictOnAnyStart("1e-12") + " --start-model-relift-passes 0";
   const auto runInto = [&](const std::string& out, const std::string& extra) {
     return runWithReport("run --dataset " + dataset + flags + extra, path(out));
   };

@@ -90,6 +90,9 @@ struct RealSet {
   std::string why;     ///< Why the entry differs from the defaults, for the table's notes.
   /// Ground-truth curves below --data (curvesfm eval-map's --gt-curves); empty: none.
   std::string gt_curves = "";
+  /// A photo `curvesfm synth planar` renders into `subdir` before the set runs (--planar-photos);
+  /// empty: the folder is there already.
+  std::string rendered_from = "";
 };
 
 // The sets of ../shared/data (INDEX.md there). 7-Scenes' camera-intrinsics.txt is the depth
@@ -936,31 +939,44 @@ std::vector<RealSet> builtInSets(const BenchOptions& options) {
   return sets;
 }
 
-// Renders every --planar-photos photo as a planar sequence below `out` (curvesfm synth planar:
-// the paper's orbit over the photo, its ground truth, and no initial poses, so that an init start
-// runs the point initialiser) and returns them as sets.
+// Every --planar-photos photo as a set whose folder below `out` is still to be rendered
+// (renderPlanarSets), once every set has been checked.
 std::vector<RealSet> planarSets(const BenchOptions& options, const fs::path& out) {
   std::vector<RealSet> sets;
   for (const std::string& photo : options.planar_photos) {
     const fs::path image = fs::path(options.planar_dir) / photo;
-    if (!fs::is_regular_file(image))
+    if (!fs::is_regular_file(image)) {
       throw IoError(image.string(), "no such photo (--planar-photos)");
-    const fs::path dir = fs::absolute(out / "planar_sets" / fs::path(photo).stem());
-    fs::remove_all(dir);
-    const fs::path log = out / ("planar_sets_" + fs::path(photo).stem().string() + ".log");
+    }
+    const std::string stem = fs::path(photo).stem().string();
+    RealSet set;
+    set.name = "planar_" + stem;
+    set.subdir = fs::absolute(out / "planar_sets" / stem).string();
+    set.why = "rendered from " + photo + " by curvesfm synth planar (its defaults)";
+    set.rendered_from = image.string();
+    sets.push_back(set);
+  }
+  return sets;
+}
+
+// Renders the sets that come from a photo (curvesfm synth planar: the paper's orbit over it, its
+// ground truth, and no initial poses, so that an init start runs the point initialiser).
+void renderPlanarSets(const BenchOptions& options, const fs::path& out,
+                      const std::vector<RealSet>& sets) {
+  for (const RealSet& set : sets) {
+    if (set.rendered_from.empty()) continue;
+    fs::remove_all(set.subdir);
+    const fs::path log = out / (set.name + ".render.log");
     const bench::ProcessResult r =
-        bench::runProcess({options.curvesfm, "synth", "planar", "--image", image.string(), "--out",
-                           dir.string(), "--init-poses", "false"},
+        bench::runProcess({options.curvesfm, "synth", "planar", "--image", set.rendered_from,
+                           "--out", set.subdir, "--init-poses", "false"},
                           log.string(), log.string());
     if (r.exit_code != 0) {
-      throw Error("real_bench: curvesfm synth planar --image " + image.string() +
+      throw Error("real_bench: curvesfm synth planar --image " + set.rendered_from +
                   " failed (exit code " + std::to_string(r.exit_code) +
                   "): " + bench::lastLine(log.string()));
     }
-    sets.push_back({"planar_" + fs::path(photo).stem().string(), dir.string(), "", 0, 1,
-                    "rendered from " + photo + " by curvesfm synth planar (its defaults)"});
   }
-  return sets;
 }
 
 // --extra-sets as sets, each named by its folder.
@@ -985,9 +1001,10 @@ std::vector<RealSet> selectedSets(const BenchOptions& options, const fs::path& o
   std::set<std::string> names;
   for (const RealSet& set : sets) {
     if (!names.insert(set.name).second) {
-      throw InvalidOptions("BenchOptions", "extra_sets", set.name,
+      const bool planar = !set.rendered_from.empty();
+      throw InvalidOptions("BenchOptions", planar ? "planar_photos" : "extra_sets", set.name,
                            "two sets named " + set.name + ": each names its output folder")
-          .withFlag("extra-sets");
+          .withFlag(planar ? "planar-photos" : "extra-sets");
     }
   }
   return sets;
@@ -1004,6 +1021,7 @@ int run(const BenchOptions& options, const std::string& command) {
                   "none of the benchmark's sets is there, and no --planar-photos or "
                   "--extra-sets given");
   }
+  renderPlanarSets(options, out, sets);
   // COLMAP's GUI library needs a display unless Qt draws off-screen.
   setenv("QT_QPA_PLATFORM", "offscreen", 0);
   const std::vector<Variant> variants = selectedVariants(options);

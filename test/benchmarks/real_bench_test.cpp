@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "test/support/run_executable.h"
@@ -71,6 +72,19 @@ TEST(RealBenchCommandLine, NamesAMissingPlanarPhoto) {
       out);
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_THAT(r.output, HasSubstr("/nonexistent/photos/left01.jpg: no such photo"));
+}
+
+TEST(RealBenchCommandLine, RefusesTwoPlanarPhotosOfOneNameBeforeRenderingEither) {
+  const std::string root = ::testing::TempDir() + "real_bench_photo_twins";
+  std::filesystem::create_directories(root + "/photos");
+  std::ofstream(root + "/photos/wall.png") << "not read before the check";
+  std::ofstream(root + "/photos/wall.jpg") << "not read before the check";
+  const testing::CommandResult r =
+      runRealBench("--sets none --planar-dir " + root +
+                   "/photos --planar-photos wall.png,wall.jpg" + " --out " + root + "/out");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("--planar-photos = planar_wall: two sets named planar_wall"));
+  EXPECT_FALSE(std::filesystem::exists(root + "/out/planar_sets"));
 }
 
 TEST(RealBenchCommandLine, NamesNoSetToRun) {

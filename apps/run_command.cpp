@@ -718,10 +718,11 @@ void printSanity(const RunSanity& s) {
 
 // What the images say about a given start (StartModel); when its poses are off each on its own,
 // the BA ties each keyframe to its start (the start prior, at the measured sigmas) instead of
-// tying each motion to the start's (the motion prior), unless the start prior was asked for.
+// tying each motion to the start's (the motion prior), unless the start prior was asked for; a
+// start so tied runs at most StartModelOptions::reassociation_rounds re-association rounds.
 std::optional<StartModelEstimate> readStartModel(const RunInput& input,
                                                  const StartModelOptions& options,
-                                                 CurveBundleAdjustmentOptions* ba) {
+                                                 PipelineOptions* pipeline) {
   if (!options.from_images || !input.initialisation || input.init_poses_source == "initialiser") {
     return std::nullopt;
   }
@@ -734,6 +735,7 @@ std::optional<StartModelEstimate> readStartModel(const RunInput& input,
       "to %d)",
       toString(e.model).c_str(), e.frames_measured, e.rotation_rms_deg, e.rotation_to_measurement,
       e.centre_rms_spacings, e.variogram_growth, e.variogram_lag);
+  CurveBundleAdjustmentOptions* ba = &pipeline->ba;
   if (tiesEachPose(e, options) && !ba->start_prior) {
     ba->motion_prior = false;
     ba->start_prior = true;
@@ -742,12 +744,17 @@ std::optional<StartModelEstimate> readStartModel(const RunInput& input,
     // (the benches) is the frames' one measured here.
     ba->start_prior_centre_sigma_rel =
         std::max(options.prior_sigma_scale * e.centre_rms_spacings, 1e-6);
+    if (options.reassociation_rounds >= 0) {
+      pipeline->reassociation_rounds =
+          std::min(pipeline->reassociation_rounds, options.reassociation_rounds);
+    }
     std::printf(
         "; the BA ties each keyframe to its start (start prior %.3g deg, %.3g spacings) "
         "instead of each motion to the start's, and lifts the map again at the refined poses "
-        "(--start-model-relift-passes %d)",
-        ba->start_prior_rotation_sigma_deg, ba->start_prior_centre_sigma_rel,
-        options.relift_passes);
+        "(--start-model-relift-passes %d), with at most %d re-association rounds a pass "
+        "(--start-model-reassociation-rounds)",
+        ba->start_prior_rotation_sigma_deg, ba->start_prior_centre_sigma_rel, options.relift_passes,
+        pipeline->reassociation_rounds);
   }
   std::printf("\n");
   return e;
@@ -953,7 +960,7 @@ int RunCommand::run() const {
 
   PipelineOptions options = options_;
   const std::optional<StartModelEstimate> start_model =
-      readStartModel(input, start_model_, &options.ba);
+      readStartModel(input, start_model_, &options);
   options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
   std::unique_ptr<Pipeline> pipeline;
   PipelineResult result;
@@ -1022,6 +1029,7 @@ int RunCommand::run() const {
        {"camera", cameraToJson(pipeline->undistortedCamera())},
        {"start_model", startModelJson(start_model, tied_start, options.ba)},
        {"relift_passes_run", relift_passes},
+       {"reassociation_rounds_allowed", options.reassociation_rounds},
        {"scene_scale", result.scene_scale},
        {"counts",
         {{"frames", input.frames.size()},

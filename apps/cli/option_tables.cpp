@@ -453,6 +453,9 @@ void addStartModelOptions(OptionsTable* table, StartModelOptions* o, const std::
       .boolean("tie_drifting_per_pose", "tie-drifting-per-pose", &o->tie_drifting_per_pose,
                "A start read as drifting is tied to each pose and lifted again as a per-pose one "
                "(false: it keeps the motion prior)")
+      .number("reassociation_rounds", "reassociation-rounds", &o->reassociation_rounds,
+              "A start tied per pose runs at most this many re-association rounds per pass "
+              "(-1: --reassociation-rounds)")
       .number("max_reprojection_error_px", "max-reprojection-error", &o->max_reprojection_error_px,
               "PnP's inlier threshold (px)");
 }

@@ -28,6 +28,8 @@ void StartModelOptions::validate() const {
   require.positive("max_reprojection_error_px", max_reprojection_error_px);
   require(relift_passes >= 0 && relift_passes <= 100, "relift_passes", relift_passes,
           "in [0, 100]");
+  require(reassociation_rounds >= -1 && reassociation_rounds <= 100, "reassociation_rounds",
+          reassociation_rounds, "-1 or in [0, 100]");
 }
 
 namespace {

@@ -114,6 +114,16 @@ struct StartModelOptions {
   /// (its ground truth's own drift) 15.4 mm off instead of 19.8 (docs/benchmarks.md, "A start
   /// that moves is tied per pose"). False keeps the motion prior for drifting starts.
   bool tie_drifting_per_pose = true;
+  /// A start tied per pose runs at most this many re-association rounds in each pass
+  /// (PipelineOptions::reassociation_rounds, 3; count, -1: the pipeline's own). Its relift pass
+  /// already registers the map again at better poses, and each further round adds matches that
+  /// pull a close start away. Two rather than three, side by side in one build (session 37):
+  /// Pavilion's noise starts median 0.41 against 0.43 x, KITTI 06's 0.55 against 0.59 x, the
+  /// planar per-pose starts 37 against 35 of 45 at or below 0.5 x, the 7-Scenes kitchen's truth
+  /// 12.7 against 14.3 mm. One round gains more on the kitchen (9.6 mm) but loses on Pavilion
+  /// (median 0.48 x) and KITTI (0.62 x) (docs/benchmarks.md, "Two re-association rounds for a
+  /// start tied per pose"). -1 or in [0, 100].
+  int reassociation_rounds = 2;
   /// PnP's inlier threshold on the reprojection error (px). Finite, > 0.
   double max_reprojection_error_px = 4.0;
 

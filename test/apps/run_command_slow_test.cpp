@@ -238,12 +238,13 @@ TEST_F(RunCommandTest, AStartOffPerPoseIsLiftedAgainOnce) {
 }
 
 // A start read as drifting is tied per pose too unless --start-model-tie-drifting-per-pose false
-// leaves it to the motion prior. As above, the thresholds are set so that any measured start of
-// the short sequence is read as drifting.
+// leaves it to the motion prior; only a tied start's re-association rounds are limited. As above,
+// the thresholds are set so that any measured start of the short sequence is read as drifting.
 TEST_F(RunCommandTest, ADriftingStartIsTiedPerPoseUnlessLeftToTheMotionPrior) {
   const std::string dataset = writeShortPlanarDataset();
-  const std::string flags =
-      shortPlanarFlags() + verdictOnAnyStart("1e-12") + " --start-model-relift-passes 0";
+  const std::string flags = shortPlanarFlags() + verdictOnAnyStart("1e-12") +
+                            " --start-model-relift-passes 0 --reassociation-rounds 2" +
+                            " --start-model-reassociation-rounds 0";
   const auto runInto = [&](const std::string& out, const std::string& extra) {
     return runWithReport("run --dataset " + dataset + flags + extra, path(out));
   };
@@ -252,12 +253,16 @@ TEST_F(RunCommandTest, ADriftingStartIsTiedPerPoseUnlessLeftToTheMotionPrior) {
   EXPECT_TRUE(tied["start_model"]["switched_to_start_prior"].get<bool>());
   EXPECT_GT(tied["start_model"]["start_prior_rotation_sigma_deg"].get<double>(), 0.0);
   EXPECT_THAT(tied_output.output, HasSubstr("the BA ties each keyframe to its start"));
+  EXPECT_EQ(tied["reassociation_rounds_allowed"], 0);
+  EXPECT_TRUE(tied["reassociation"].empty());
 
   const auto [kept_output, kept] = runInto("kept", " --start-model-tie-drifting-per-pose false");
   ASSERT_EQ(kept["start_model"]["model"], "drifting") << kept_output.output;
   EXPECT_FALSE(kept["start_model"]["switched_to_start_prior"].get<bool>());
   EXPECT_TRUE(kept["start_model"]["start_prior_rotation_sigma_deg"].is_null());
   EXPECT_THAT(kept_output.output, Not(HasSubstr("the BA ties each keyframe to its start")));
+  EXPECT_EQ(kept["reassociation_rounds_allowed"], 2);
+  EXPECT_FALSE(kept["reassociation"].empty());
 }
 
 // The fit checks after global BA: with a residual bound no curve meets, every curve of the global

@@ -161,6 +161,9 @@ TEST(StartModel, BadOptionsNameTheField) {
   o = StartModelOptions();
   o.rotation_prior_sigma_scale = 0.0;
   expectRejected(o, "rotation_prior_sigma_scale");
+  o = StartModelOptions();
+  o.reassociation_rounds = -2;
+  expectRejected(o, "reassociation_rounds");
 }
 
 }  // namespace

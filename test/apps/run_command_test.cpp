@@ -145,6 +145,11 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   EXPECT_THAT(result.output,
               HasSubstr("--start-model-max-variogram-growth = -1: must be > 0 and finite "
                         "(StartModelOptions.max_variogram_growth)"));
+  // Unlike --reassociation-rounds, the start model's limit takes -1 (none) but nothing below.
+  result = run("--start-model-reassociation-rounds -2");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--start-model-reassociation-rounds = -2: -1 or in [0, 100] "
+                                       "(StartModelOptions.reassociation_rounds)"));
   // The same struct in two places: the error names the place's flag.
   result = run("--global-ba-max-rounds 0");
   EXPECT_EQ(result.exit_code, 2);

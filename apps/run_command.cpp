@@ -449,6 +449,28 @@ nlohmann::json globalCostsToJson(const ScheduleReport& report) {
           {"final", costsToJson(last->summary.final_cost_by_type)}};
 }
 
+// The costs per factor type after the run's last BA (the re-association rounds' last, else the
+// first global BA): the fit its poses and map end at. Per curve observation it tells which of
+// several starts of one set the images agree with best; across sets it means little.
+std::map<std::string, FactorTypeCost> finalFit(const PipelineResult& result) {
+  const ScheduleReport& last =
+      result.reassociation.empty() ? result.global_ba : result.reassociation.back().global_ba;
+  const ScheduleRound* solved = nullptr;
+  for (const ScheduleRound& round : last.rounds) {
+    if (!round.skipped) solved = &round;
+  }
+  return solved ? solved->summary.final_cost_by_type : std::map<std::string, FactorTypeCost>();
+}
+
+void printFinalFit(const std::map<std::string, FactorTypeCost>& fit) {
+  const auto curves = fit.find("curve_reprojection");  // CurveReprojectionFactor::typeName()
+  if (curves == fit.end() || curves->second.count == 0) return;
+  std::printf(
+      "fit: curve cost %.4f per observation over %d observations after the last global BA (lower "
+      "means the images agree better; it compares starts of one set, report.json final_fit)\n",
+      curves->second.cost / curves->second.count, curves->second.count);
+}
+
 nlohmann::json ateToJson(const AteResult& ate) {
   const auto stats = [](const std::optional<TrajectoryEvaluation>& e) -> nlohmann::json {
     if (!e) return nullptr;
@@ -979,6 +1001,7 @@ int RunCommand::run() const {
   }
   const AteResult ate = evaluateAte(result, d);
   const std::vector<StageMotion> motions = stageMotions(result, d);
+  const std::map<std::string, FactorTypeCost> fit = finalFit(result);
 
   writeTrajectory(joinPath(out_dir_, "trajectory.txt"),
                   stampedPoses(result.keyframe_timestamps, result.keyframe_cam_from_world));
@@ -1048,6 +1071,7 @@ int RunCommand::run() const {
        {"global_ba", scheduleReportToJson(result.global_ba)},
        {"global_ba_cost_by_type", globalCostsToJson(result.global_ba)},
        {"reassociation", reassociationToJson(result.reassociation)},
+       {"final_fit", costsToJson(fit)},
        {"final_samples", sampleCountsToJson(result.final_samples)},
        {"ate", ateToJson(ate)},
        {"pose_stages", stageMotionsJson(motions, result.scene_scale)},
@@ -1060,6 +1084,7 @@ int RunCommand::run() const {
   printSummary(input, result, seconds, images_ahead_ ? image_wait_seconds : -1.0);
   printAte(ate, d.ground_truth_source);
   printStageMotions(motions);
+  printFinalFit(fit);
   printCurveStatistics(result.curve_statistics);
   printExport(exported, result.curves.size(), export_min_epipolar_angle_deg_);
   printSanity(result.sanity);

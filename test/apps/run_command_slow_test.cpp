@@ -96,6 +96,17 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
     EXPECT_EQ(round["left_to_other_curves"].get<int>(), 0);  // Both checks are off by default.
     EXPECT_TRUE(round["global_ba"].contains("rounds"));
   }
+  // The fit the run ends at: the last global BA's costs per factor type.
+  const nlohmann::json& last_ba = report["reassociation"].empty()
+                                      ? report["global_ba"]
+                                      : report["reassociation"].back()["global_ba"];
+  nlohmann::json last_costs;
+  for (const auto& round : last_ba["rounds"]) {
+    if (!round["skipped"].get<bool>()) last_costs = round["summary"]["final_cost_by_type"];
+  }
+  EXPECT_EQ(report["final_fit"], last_costs);
+  EXPECT_GT(report["final_fit"]["curve_reprojection"]["count"].get<int>(), 0);
+  EXPECT_THAT(result.output, HasSubstr("fit: curve cost "));
   EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));
   // Keyframe 5's local BA refined the curves its window observes.
   EXPECT_GT(report["frames"][5]["local_ba_iterations"].get<int>(), 0);

@@ -848,8 +848,16 @@ void printFitSummary(const std::vector<Row>& rows) {
       if (r != *truth) std::printf(" (%.3f x truth)", r->curve_cost_per_observation / reference);
       if (r->curve_cost_per_observation < best->curve_cost_per_observation) best = r;
     }
-    std::printf("; lowest: %s%s\n", best->start.c_str(),
-                best == *truth ? "" : " (the images agree better with a result off the truth)");
+    // One run's map moves the figure by a few per cent (a rendered planar scene, exact truth: a
+    // noise run at 0.96 x its truth's), so a smaller lead says nothing.
+    constexpr double kSpread = 0.05;
+    std::printf("; lowest: %s", best->start.c_str());
+    if (best != *truth && best->curve_cost_per_observation < (1.0 - kSpread) * reference) {
+      std::printf(" (the images agree better with a result off the truth)");
+    } else if (best != *truth) {
+      std::printf(" (within %.0f %% of the truth's: one run's spread)", 100.0 * kSpread);
+    }
+    std::printf("\n");
   }
 }
 

@@ -435,31 +435,33 @@ nlohmann::json frameToJson(const KeyframeStats& s) {
       {"local_ba_iterations", s.local_ba_iterations}};
 }
 
+// The first and the last solve a schedule ran (its skipped phases aside); nullptr if none ran.
+const ScheduleRound* firstSolvedRound(const ScheduleReport& report) {
+  const auto solved = std::find_if(report.rounds.begin(), report.rounds.end(),
+                                   [](const ScheduleRound& round) { return !round.skipped; });
+  return solved == report.rounds.end() ? nullptr : &*solved;
+}
+const ScheduleRound* lastSolvedRound(const ScheduleReport& report) {
+  const auto solved = std::find_if(report.rounds.rbegin(), report.rounds.rend(),
+                                   [](const ScheduleRound& round) { return !round.skipped; });
+  return solved == report.rounds.rend() ? nullptr : &*solved;
+}
+
 // Costs per factor type before the first and after the last solve of global BA.
 nlohmann::json globalCostsToJson(const ScheduleReport& report) {
-  const ScheduleRound* first = nullptr;
-  const ScheduleRound* last = nullptr;
-  for (const ScheduleRound& round : report.rounds) {
-    if (round.skipped) continue;
-    if (!first) first = &round;
-    last = &round;
-  }
+  const ScheduleRound* first = firstSolvedRound(report);
   if (!first) return nlohmann::json::object();
   return {{"initial", costsToJson(first->summary.initial_cost_by_type)},
-          {"final", costsToJson(last->summary.final_cost_by_type)}};
+          {"final", costsToJson(lastSolvedRound(report)->summary.final_cost_by_type)}};
 }
 
 // The costs per factor type after the run's last BA (the re-association rounds' last, else the
 // first global BA): the fit its poses and map end at. Per curve observation it tells which of
 // several starts of one set the images agree with best; across sets it means little.
 std::map<std::string, FactorTypeCost> finalFit(const PipelineResult& result) {
-  const ScheduleReport& last =
-      result.reassociation.empty() ? result.global_ba : result.reassociation.back().global_ba;
-  const ScheduleRound* solved = nullptr;
-  for (const ScheduleRound& round : last.rounds) {
-    if (!round.skipped) solved = &round;
-  }
-  return solved ? solved->summary.final_cost_by_type : std::map<std::string, FactorTypeCost>();
+  const ScheduleRound* last = lastSolvedRound(
+      result.reassociation.empty() ? result.global_ba : result.reassociation.back().global_ba);
+  return last ? last->summary.final_cost_by_type : std::map<std::string, FactorTypeCost>();
 }
 
 void printFinalFit(const std::map<std::string, FactorTypeCost>& fit) {

@@ -852,10 +852,12 @@ void printFitSummary(const std::vector<Row>& rows) {
     // noise run at 0.96 x its truth's), so a smaller lead says nothing.
     constexpr double kSpread = 0.05;
     std::printf("; lowest: %s", best->start.c_str());
-    if (best != *truth && best->curve_cost_per_observation < (1.0 - kSpread) * reference) {
-      std::printf(" (the images agree better with a result off the truth)");
-    } else if (best != *truth) {
-      std::printf(" (within %.0f %% of the truth's: one run's spread)", 100.0 * kSpread);
+    if (best != *truth) {
+      if (best->curve_cost_per_observation < (1.0 - kSpread) * reference) {
+        std::printf(" (the images agree better with a result off the truth)");
+      } else {
+        std::printf(" (within %.0f %% of the truth's: one run's spread)", 100.0 * kSpread);
+      }
     }
     std::printf("\n");
   }

@@ -33,10 +33,14 @@ cv::Mat toGrey(const cv::Mat& image) {
 }
 
 void gradients(const cv::Mat& grey, const EdgeDetectorOptions& options, EdgeImage* result) {
-  cv::Mat blurred = grey;
+  // A new matrix: blurring into a header of `grey` would write into the caller's image.
+  cv::Mat blurred;
   if (options.blur_sigma_px > 0.0) {
     cv::GaussianBlur(grey, blurred, cv::Size(0, 0), options.blur_sigma_px, options.blur_sigma_px);
+  } else {
+    blurred = grey;
   }
+  result->blurred = blurred;
   if (options.sobel_aperture == 3) {
     // One pass for both derivatives: about half the time of two cv::Sobel calls.
     cv::spatialGradient(blurred, result->grad_x, result->grad_y, 3);

@@ -62,6 +62,9 @@ struct EdgeImage {
   /// Hysteresis thresholds actually applied (grey levels / px), automatic or given.
   double low_threshold = 0.0;
   double high_threshold = 0.0;
+  /// CV_8UC1: the grey image the gradients were taken of, after the Gaussian blur (the grey image
+  /// itself, shared, when blur_sigma_px is 0).
+  cv::Mat blurred;
 };
 
 /// Canny edge detection (paper §2.3): grey conversion, Gaussian blur, Sobel gradients, hysteresis

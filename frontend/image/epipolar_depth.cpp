@@ -222,7 +222,9 @@ inline float bilinear(const cv::Mat& image, float x, float y) {
   return upper + ay * (lower - upper);
 }
 
+// A CV_32FC1 image is taken as it is (shared, not copied).
 cv::Mat toFloat(const cv::Mat& grey) {
+  if (grey.type() == CV_32FC1) return grey;
   cv::Mat image;
   grey.convertTo(image, CV_32F);
   return image;
@@ -668,10 +670,11 @@ void checkChains(const std::vector<EdgeChain>& chains) {
 }
 
 void checkImage(const cv::Mat& image, const Camera& camera, const char* what) {
-  CURVESFM_CHECK(image.type() == CV_8UC1 && image.cols == camera.width() &&
-                 image.rows == camera.height())
-      << what << " must be CV_8UC1 of the camera size " << camera.width() << "x" << camera.height()
-      << ", got type " << image.type() << " size " << image.cols << "x" << image.rows;
+  CURVESFM_CHECK((image.type() == CV_8UC1 || image.type() == CV_32FC1) &&
+                 image.cols == camera.width() && image.rows == camera.height())
+      << what << " must be CV_8UC1 or CV_32FC1 of the camera size " << camera.width() << "x"
+      << camera.height() << ", got type " << image.type() << " size " << image.cols << "x"
+      << image.rows;
 }
 
 void checkInputs(const Camera& camera, const std::vector<EdgeChain>& chains,

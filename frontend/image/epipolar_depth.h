@@ -94,7 +94,8 @@ struct EpipolarDepthOptions {
 
 /// One reference view for the epipolar search.
 struct DepthReferenceView {
-  /// CV_8UC1 grey image, undistorted (ImageUndistorter), of the camera's size.
+  /// Grey image, undistorted (ImageUndistorter), of the camera's size: CV_8UC1, or CV_32FC1 of
+  /// the same grey levels, which the search then samples without converting it.
   cv::Mat image;
   /// The view's pose (world to camera).
   Pose3 cam_from_world;
@@ -223,7 +224,8 @@ std::vector<ReferenceCandidate> rankReferenceFrames(
 /// The variance kept is the harmonic mean of the window's inlier variances: neighbours share the
 /// pose error and overlapping 2D patches, so averaging them is not assumed to reduce it.
 ///
-/// `keyframe_image` and every reference image: CV_8UC1 grey, undistorted, of the camera's size;
+/// `keyframe_image` and every reference image: grey, undistorted, of the camera's size, CV_8UC1
+/// or CV_32FC1 (as DepthReferenceView::image);
 /// `camera` without distortion (ImageUndistorter::camera()); each chain's normals are the unit
 /// image gradients of the keyframe at its pixels (extractEdgeChains). Chain pixels outside the
 /// image are rejected as kAtImageBorder. Chains split over options.num_threads threads, no

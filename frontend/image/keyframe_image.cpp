@@ -27,6 +27,7 @@ KeyframeImage prepareKeyframeImage(const cv::Mat& image_bgr, const ImageUndistor
   prepared.edges = edge_image.edges;
   prepared.canny_low_threshold = edge_image.low_threshold;
   prepared.canny_high_threshold = edge_image.high_threshold;
+  edge_image.blurred.convertTo(prepared.grey_float, CV_32F);
   prepared.edges_seconds = secondsSince(start);
 
   start = Clock::now();

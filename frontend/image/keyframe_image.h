@@ -18,6 +18,10 @@ namespace curvesfm {
 struct KeyframeImage {
   cv::Mat image_bgr;  ///< Undistorted, CV_8UC3.
   cv::Mat grey;       ///< Undistorted, CV_8UC1.
+  /// What the depth search samples: `grey` after the edge detector's blur (EdgeImage::blurred),
+  /// CV_32FC1, converted once here, ahead, instead of for every keyframe that takes this one as
+  /// a depth reference.
+  cv::Mat grey_float;
   cv::Mat edges;      ///< CV_8UC1, 255 at edge pixels (EdgeImage::edges).
   /// Canny hysteresis thresholds applied (grey levels / px), automatic or given.
   double canny_low_threshold = 0.0;
@@ -26,7 +30,7 @@ struct KeyframeImage {
   std::shared_ptr<const NearestEdgeField> field;
   // Wall time of each part (s), on whichever thread prepared it.
   double undistort_seconds = 0.0;  ///< Undistortion and grey conversion.
-  double edges_seconds = 0.0;      ///< detectEdges + extractEdgeChains.
+  double edges_seconds = 0.0;      ///< detectEdges, extractEdgeChains, grey_float.
   double field_seconds = 0.0;
 };
 

@@ -31,7 +31,9 @@ struct Keyframe {
   // PipelineFrame::frontend_cam_from_world, in pose units, when given.
   std::optional<Pose3> given_frontend_cam_from_world;
   cv::Mat image_bgr;  // Undistorted.
-  cv::Mat grey;  // Undistorted; released once no later keyframe can take it as a depth reference.
+  // Undistorted, CV_32FC1 (KeyframeImage::grey_float); released once no later keyframe can take
+  // it as a depth reference.
+  cv::Mat grey_float;
   std::shared_ptr<const NearestEdgeField> field;
   std::vector<PointSighting> points;  // The hybrid graph's points it sees.
 };
@@ -457,7 +459,7 @@ void Pipeline::Impl::addKeyframe(const PipelineFrame& frame, const KeyframeImage
   }
   keyframe.points = frame.points;
   keyframe.image_bgr = image.image_bgr;
-  keyframe.grey = image.grey;
+  keyframe.grey_float = image.grey_float;
   keyframe.field = image.field;
   keyframes.push_back(std::move(keyframe));
 
@@ -763,10 +765,11 @@ void Pipeline::Impl::initialiseCurves(int k, const std::vector<EdgeChain>& chain
   const std::vector<int> reference_keyframes = depthReferences(k, chains);
   std::vector<DepthReferenceView> references;
   for (const int j : reference_keyframes) {
-    references.push_back({keyframes[j].grey, keyframes[j].cam_from_world});
+    references.push_back({keyframes[j].grey_float, keyframes[j].cam_from_world});
   }
-  const ChainDepths depths = estimateChainDepths(keyframes[k].grey, keyframes[k].cam_from_world,
-                                                 chains, references, *camera, depthOptions(k));
+  const ChainDepths depths =
+      estimateChainDepths(keyframes[k].grey_float, keyframes[k].cam_from_world, chains, references,
+                          *camera, depthOptions(k));
   stats->valid_depths = depths.counts.valid();
   stats->depth_seconds = secondsSince(start);
 
@@ -1030,7 +1033,7 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
   map.endKeyframe(k);
   // No later keyframe takes this one as a depth reference: a fifth of a keyframe's memory.
   if (k >= options.depth_reference_candidates) {
-    keyframes[k - options.depth_reference_candidates].grey.release();
+    keyframes[k - options.depth_reference_candidates].grey_float.release();
   }
 
   if (keyframes.size() >= 2 && map.count(CurveState::kGlobal) > 0) {

@@ -120,6 +120,23 @@ TEST(EdgeDetector, ColourAndGreyInputsAgreeAndApertureFiveWorks) {
   EXPECT_GT(fractionNear(scene.boundaries, edges.edges, 2.0), 0.95);
 }
 
+// Until session 39 the blur wrote into a grey input, and the pipeline's depth search sampled
+// that blurred image without saying so: EdgeImage::blurred now carries it.
+TEST(EdgeDetector, LeavesItsInputAsItWasAndReturnsTheBlurredImage) {
+  const Scene scene = renderScene(5.0);
+  const cv::Mat input = scene.image.clone();
+  const EdgeImage edges = detectEdges(input);
+  EXPECT_EQ(cv::countNonZero(input != scene.image), 0);
+  cv::Mat blurred;
+  cv::GaussianBlur(scene.image, blurred, cv::Size(0, 0), 1.0, 1.0);
+  ASSERT_EQ(edges.blurred.type(), CV_8UC1);
+  EXPECT_EQ(cv::countNonZero(edges.blurred != blurred), 0);
+
+  EdgeDetectorOptions unblurred;
+  unblurred.blur_sigma_px = 0.0;
+  EXPECT_EQ(detectEdges(input, unblurred).blurred.data, input.data);
+}
+
 TEST(EdgeDetector, MaskedPixelsCarryNoEdge) {
   const Scene scene = renderScene(0.0);
   cv::Mat mask(scene.image.size(), CV_8UC1, cv::Scalar(255));

@@ -351,6 +351,37 @@ TEST(EpipolarDepth, RejectsEdgesAlongTheEpipolarLine) {
   }
 }
 
+cv::Mat asFloat(const cv::Mat& grey) {
+  cv::Mat image;
+  grey.convertTo(image, CV_32F);
+  return image;
+}
+
+// The pipeline converts each keyframe once and passes CV_32FC1 images: the same depths.
+TEST(EpipolarDepth, FloatImagesGiveTheSameDepths) {
+  const PlaneScene scene = makeScene(randomTexture(1000, 800, 3));
+  const ThreeViews views;
+  const cv::Mat key = scene.render(views.key);
+  const cv::Mat side = scene.render(views.side);
+  const cv::Mat up = scene.render(views.up);
+  const std::vector<EdgeChain> chains = chainsOf(key);
+  const ChainDepths grey = estimateChainDepths(
+      key, views.key, chains, {{side, views.side}, {up, views.up}}, scene.camera, planeOptions());
+  const ChainDepths floats = estimateChainDepths(
+      asFloat(key), views.key, chains, {{asFloat(side), views.side}, {asFloat(up), views.up}},
+      scene.camera, planeOptions());
+  ASSERT_GT(grey.counts.valid(), 1000);
+  ASSERT_EQ(floats.chains.size(), grey.chains.size());
+  for (std::size_t c = 0; c < grey.chains.size(); ++c) {
+    for (std::size_t i = 0; i < grey.chains[c].size(); ++i) {
+      EXPECT_EQ(floats.chains[c][i].status, grey.chains[c][i].status);
+      EXPECT_EQ(floats.chains[c][i].depth, grey.chains[c][i].depth);
+      EXPECT_EQ(floats.chains[c][i].inverse_depth_variance,
+                grey.chains[c][i].inverse_depth_variance);
+    }
+  }
+}
+
 TEST(EpipolarDepth, ZeroBaselineHasNoReference) {
   const PlaneScene scene = makeScene(randomTexture(1000, 800, 3));
   const Pose3 key = lookingAtPlane({0.0, 0.0, 1.5}, 2.0, 0.0);
@@ -446,6 +477,8 @@ TEST(EpipolarDepth, BadInputsThrow) {
   EXPECT_THROW(estimateChainDepths(image, key, {}, {}, camera, bad), InvalidOptions);
   const cv::Mat colour(camera.height(), camera.width(), CV_8UC3);
   EXPECT_THROW(estimateChainDepths(colour, key, {}, {}, camera), CheckError);
+  const cv::Mat doubles(camera.height(), camera.width(), CV_64FC1);
+  EXPECT_THROW(estimateChainDepths(doubles, key, {}, {}, camera), CheckError);
   EXPECT_THROW(estimateChainDepths(image, key, {}, {{cv::Mat(), key}}, camera), CheckError);
   CameraIntrinsics distorted;
   distorted.k1 = 0.1;

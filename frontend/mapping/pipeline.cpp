@@ -31,8 +31,8 @@ struct Keyframe {
   // PipelineFrame::frontend_cam_from_world, in pose units, when given.
   std::optional<Pose3> given_frontend_cam_from_world;
   cv::Mat image_bgr;  // Undistorted.
-  // Undistorted, CV_32FC1 (KeyframeImage::grey_float); released once no later keyframe can take
-  // it as a depth reference.
+  // The depth search's image: undistorted grey after the edge detector's blur, CV_32FC1
+  // (KeyframeImage::grey_float); released once no later keyframe can take it as a depth reference.
   cv::Mat grey_float;
   std::shared_ptr<const NearestEdgeField> field;
   std::vector<PointSighting> points;  // The hybrid graph's points it sees.
@@ -1031,7 +1031,7 @@ KeyframeStats Pipeline::Impl::addFrame(const PipelineFrame& frame) {
 
   initialiseCurves(k, unexplainedRuns(chains, explained, options.chains.min_length_px), &stats);
   map.endKeyframe(k);
-  // No later keyframe takes this one as a depth reference: a fifth of a keyframe's memory.
+  // No later keyframe takes this one as a depth reference: its largest image (4 bytes a pixel).
   if (k >= options.depth_reference_candidates) {
     keyframes[k - options.depth_reference_candidates].grey_float.release();
   }

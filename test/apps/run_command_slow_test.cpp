@@ -19,6 +19,7 @@
 namespace curvesfm {
 namespace {
 
+using ::testing::ContainsRegex;
 using ::testing::HasSubstr;
 using ::testing::Not;
 using ::testing::StartsWith;
@@ -54,6 +55,7 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_THAT(result.output, HasSubstr("run: 6 frames (0 of 6 images without an initial pose"));
   EXPECT_THAT(result.output, HasSubstr("ATE (sim3) vs " + dataset + "/groundtruth.txt"));
   EXPECT_THAT(result.output, HasSubstr("frontend per keyframe (mean ms): undistort "));
+  EXPECT_THAT(result.output, ContainsRegex("\\(image stage [0-9.]+, the rest [0-9.]+\\)"));
 
   EXPECT_EQ(readTrajectory(out + "/trajectory.txt").size(), 6u);
   for (const char* name :

@@ -525,13 +525,12 @@ void printAte(const AteResult& ate, const std::string& ground_truth_path) {
 void printFrontendStages(const std::vector<KeyframeStats>& frames) {
   const KeyframeTimes t = keyframeTimes(frames);
   if (t.keyframes == 0) return;
-  const double image_stage = t.undistort_ms + t.edges_ms + t.field_ms;
   std::printf(
       "frontend per keyframe (mean ms): undistort %.1f, edges %.1f, field %.1f, depth %.1f, "
       "correspondence %.1f, initialise %.1f; total %.1f (image stage %.1f, the rest %.1f), "
       "slowest keyframe %.1f\n",
       t.undistort_ms, t.edges_ms, t.field_ms, t.depth_ms, t.correspondence_ms, t.initialise_ms,
-      t.frontend_ms, image_stage, t.frontend_ms - image_stage, t.slowest_frontend_ms);
+      t.frontend_ms, t.image_stage_ms, t.frontend_ms - t.image_stage_ms, t.slowest_frontend_ms);
 }
 
 // A line at most every `interval` seconds of a global BA (re-association rounds included), so
@@ -577,7 +576,7 @@ void printSummary(const RunInput& input, const PipelineResult& r, double seconds
   double frontend = 0.0, image_stage = 0.0, local_ba = 0.0;
   for (const KeyframeStats& s : r.frames) {
     frontend += s.frontendSeconds();
-    image_stage += s.undistort_seconds + s.edges_seconds + s.field_seconds;
+    image_stage += s.imageStageSeconds();
     local_ba += s.local_ba_seconds;
   }
   const CurveGrowth growth = curveGrowth(r.frames);

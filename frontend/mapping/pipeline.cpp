@@ -1073,12 +1073,13 @@ KeyframeTimes keyframeTimes(const std::vector<KeyframeStats>& frames) {
     t.correspondence_ms += s.correspondence_seconds;
     t.initialise_ms += s.initialise_seconds;
     t.frontend_ms += s.frontendSeconds();
+    t.image_stage_ms += s.imageStageSeconds();
     t.local_ba_ms += s.local_ba_seconds;
     t.slowest_frontend_ms = std::max(t.slowest_frontend_ms, 1e3 * s.frontendSeconds());
   }
   const double ms_per_keyframe = t.keyframes == 0 ? 0.0 : 1e3 / t.keyframes;
   for (double* v : {&t.undistort_ms, &t.edges_ms, &t.field_ms, &t.depth_ms, &t.correspondence_ms,
-                    &t.initialise_ms, &t.frontend_ms, &t.local_ba_ms}) {
+                    &t.initialise_ms, &t.frontend_ms, &t.image_stage_ms, &t.local_ba_ms}) {
     *v *= ms_per_keyframe;
   }
   return t;

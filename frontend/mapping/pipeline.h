@@ -280,9 +280,10 @@ struct KeyframeStats {
     return rejected_duplicate + rejected_depth + rejected_edge_distance +
            rejected_viewing_direction + rejected_appearance;
   }
+  /// The image stage (prepareKeyframeImage), which may run ahead on its own thread.
+  double imageStageSeconds() const { return undistort_seconds + edges_seconds + field_seconds; }
   double frontendSeconds() const {
-    return undistort_seconds + edges_seconds + field_seconds + depth_seconds +
-           correspondence_seconds + initialise_seconds;
+    return imageStageSeconds() + depth_seconds + correspondence_seconds + initialise_seconds;
   }
 };
 
@@ -303,7 +304,8 @@ struct KeyframeTimes {
   double depth_ms = 0.0;
   double correspondence_ms = 0.0;
   double initialise_ms = 0.0;
-  double frontend_ms = 0.0;  ///< Sum of the six above.
+  double frontend_ms = 0.0;     ///< Sum of the six above.
+  double image_stage_ms = 0.0;  ///< Of which undistort, edges and field (imageStageSeconds).
   double local_ba_ms = 0.0;
   double slowest_frontend_ms = 0.0;
 };

@@ -46,6 +46,29 @@ TEST(PipelineOptions, ValidateNamesTheStageAndField) {
   EXPECT_FALSE(PipelineOptions{}.local_ba_refines_poses);
 }
 
+// Means over the keyframes only; the image stage is the frontend's first three stages.
+TEST(KeyframeTimes, AverageTheKeyframesStages) {
+  KeyframeStats key;
+  key.keyframe_index = 0;
+  key.undistort_seconds = 0.001;
+  key.edges_seconds = 0.002;
+  key.field_seconds = 0.003;
+  key.depth_seconds = 0.004;
+  key.correspondence_seconds = 0.005;
+  key.initialise_seconds = 0.006;
+  KeyframeStats slower = key;
+  slower.keyframe_index = 1;
+  slower.depth_seconds = 0.014;
+  KeyframeStats skipped;  // No keyframe: keyframe_index -1.
+  skipped.edges_seconds = 1.0;
+  const KeyframeTimes t = keyframeTimes({key, skipped, slower});
+  EXPECT_EQ(t.keyframes, 2);
+  EXPECT_NEAR(t.image_stage_ms, 6.0, 1e-9);
+  EXPECT_NEAR(t.depth_ms, 9.0, 1e-9);
+  EXPECT_NEAR(t.frontend_ms, 26.0, 1e-9);
+  EXPECT_NEAR(t.slowest_frontend_ms, 31.0, 1e-9);
+}
+
 TEST(PipelineOptions, LocalBaKeyframesPerCurveMustExceedTheWindow) {
   PipelineOptions options;
   options.local_ba_max_curve_keyframes = options.local_ba.local_window;

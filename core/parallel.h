@@ -1,5 +1,7 @@
 #pragma once
 
+#include <algorithm>
+#include <atomic>
 #include <exception>
 #include <functional>
 #include <thread>
@@ -28,6 +30,25 @@ inline void runInParallel(int num_threads, const std::function<void(int thread)>
   for (const std::exception_ptr& error : errors) {
     if (error) std::rethrow_exception(error);
   }
+}
+
+/// Runs work(thread, i) for every i in [0, count) on up to num_threads threads (thread 0 the
+/// calling one), each thread taking the next `block` items whenever it is done with its last:
+/// a thread that shares its core with other work takes fewer, where a fixed split would leave the
+/// others idle at the end, waiting for it. Which thread runs an item, and when, is not fixed, so
+/// work must write its item's result alone. Exceptions as runInParallel.
+inline void forEachInParallel(int num_threads, int count, int block,
+                              const std::function<void(int thread, int item)>& work) {
+  if (count <= 0) return;
+  block = std::max(block, 1);
+  std::atomic<int> next{0};
+  const int threads = std::clamp((count + block - 1) / block, 1, std::max(num_threads, 1));
+  runInParallel(threads, [&](int t) {
+    for (int first = next.fetch_add(block); first < count; first = next.fetch_add(block)) {
+      const int last = std::min(count, first + block);
+      for (int i = first; i < last; ++i) work(t, i);
+    }
+  });
 }
 
 }  // namespace curvesfm

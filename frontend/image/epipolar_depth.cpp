@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -756,17 +757,16 @@ std::vector<ReferenceCandidate> rankReferenceFrames(
 
 namespace {
 
-// Below this many chain pixels a thread costs more to start than its share saves (a search takes
-// about 2 us a pixel).
-constexpr std::size_t kMinPixelsPerThread = 256;
+// Below this many chain pixels a run is not worth a thread of its own (a search takes about 2 us
+// a pixel, a thread tens of us to start).
+constexpr std::size_t kMinPixelsPerRun = 256;
 
-// Where each of up to `threads` runs of consecutive chains starts, with about as many pixels
-// each, then chains.size().
-std::vector<std::size_t> splitByPixels(const std::vector<EdgeChain>& chains, int threads) {
+// Where each of up to `runs` runs of consecutive chains starts, with about as many pixels each,
+// then chains.size().
+std::vector<std::size_t> splitByPixels(const std::vector<EdgeChain>& chains, std::size_t runs) {
   std::size_t total = 0;
   for (const EdgeChain& chain : chains) total += chain.pixels.size();
-  const std::size_t runs =
-      std::clamp<std::size_t>(total / kMinPixelsPerThread, 1, static_cast<std::size_t>(threads));
+  runs = std::clamp<std::size_t>(total / kMinPixelsPerRun, 1, runs);
   std::vector<std::size_t> first = {0};
   std::size_t seen = 0;
   for (std::size_t c = 0; c < chains.size() && first.size() < runs; ++c) {
@@ -794,23 +794,28 @@ ChainDepths estimateChainDepths(const cv::Mat& keyframe_image, const Pose3& keyf
   const DepthSearcher searcher(keyframe_image, references, std::move(geometries), camera, options);
   ChainDepths result;
   result.chains.resize(chains.size());
-  const std::vector<std::size_t> first = splitByPixels(chains, options.num_threads);
-  const int threads = static_cast<int>(first.size()) - 1;
-  std::vector<DepthCounts> counts(threads);
-  runInParallel(threads, [&](int t) {
-    DepthSearcher own = searcher;  // Shares the images; its own scratch buffers.
-    std::vector<RawDepth> raw;
-    for (std::size_t c = first[t]; c < first[t + 1]; ++c) {
+  // Several runs a thread, taken as the threads come free: a thread may share its core with
+  // other work (the pipeline's image stage ahead), and a fixed split would wait for it.
+  constexpr std::size_t kRunsPerThread = 8;
+  const std::vector<std::size_t> first =
+      splitByPixels(chains, kRunsPerThread * static_cast<std::size_t>(options.num_threads));
+  const int runs = static_cast<int>(first.size()) - 1;
+  std::vector<DepthCounts> counts(options.num_threads);
+  std::vector<std::optional<DepthSearcher>> own(options.num_threads);  // Shares the images.
+  std::vector<std::vector<RawDepth>> raw(options.num_threads);
+  forEachInParallel(options.num_threads, runs, 1, [&](int t, int run) {
+    if (!own[t]) own[t].emplace(searcher);  // Its own scratch buffers.
+    for (std::size_t c = first[run]; c < first[run + 1]; ++c) {
       const EdgeChain& chain = chains[c];
       const int n = static_cast<int>(chain.pixels.size());
-      raw.assign(n, RawDepth());
+      raw[t].assign(n, RawDepth());
       for (int i = 0; i < n; i += options.pixel_step) {
-        raw[i] = own.search(chain.pixels[i], chain.normals[i]);
+        raw[t][i] = own[t]->search(chain.pixels[i], chain.normals[i]);
       }
       std::vector<PixelDepth>& out = result.chains[c];
       out.resize(n);
       for (int i = 0; i < n; ++i) {
-        out[i] = smoothPixel(raw, i, chain.closed, options);
+        out[i] = smoothPixel(raw[t], i, chain.closed, options);
         ++counts[t].by_status[static_cast<int>(out[i].status)];
       }
     }

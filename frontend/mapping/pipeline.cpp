@@ -533,18 +533,18 @@ Pipeline::Impl::SegmentAttempt Pipeline::Impl::attemptRegistration(
 }
 
 // attemptRegistration for each of `segments` in keyframe k against one fixed `explained` mask,
-// spread over registration_threads threads; the attempts in the order of `segments`.
+// on registration_threads threads; the attempts in the order of `segments`.
 std::vector<Pipeline::Impl::SegmentAttempt> Pipeline::Impl::attemptAll(
     int k, const KeyframeView& view, const std::vector<SegmentRef>& segments,
     const CorrespondenceOptions& checks, const cv::Mat* explained) const {
   std::vector<SegmentAttempt> attempts(segments.size());
-  // Interleaved, since the segments of one curve cost alike and curves differ.
-  const int threads = options.registration_threads;
-  runInParallel(threads, [&](int t) {
-    for (std::size_t s = t; s < segments.size(); s += threads) {
-      attempts[s] = attemptRegistration(k, view, segments[s], checks, explained, nullptr);
-    }
-  });
+  // In blocks taken as the threads come free: curves differ in cost, and a thread may share its
+  // core with the image stage ahead, where a fixed split would leave the others waiting for it.
+  constexpr int kBlock = 32;
+  forEachInParallel(
+      options.registration_threads, static_cast<int>(segments.size()), kBlock, [&](int, int s) {
+        attempts[s] = attemptRegistration(k, view, segments[s], checks, explained, nullptr);
+      });
   return attempts;
 }
 

@@ -5,6 +5,7 @@
 #include <atomic>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace curvesfm {
@@ -30,6 +31,49 @@ TEST(RunInParallel, RethrowsAWorkersExceptionOnTheCallingThread) {
     EXPECT_STREQ(error.what(), "thread 1");
   }
   EXPECT_EQ(finished.load(), 1);
+}
+
+TEST(ForEachInParallel, RunsEveryItemOnceOnNoMoreThreadsThanBlocks) {
+  std::vector<std::atomic<int>> runs(103);
+  std::vector<std::atomic<int>> by_thread(8);
+  forEachInParallel(8, 103, 10, [&](int t, int i) {
+    ++runs[i];
+    ++by_thread[t];
+  });
+  for (const std::atomic<int>& count : runs) EXPECT_EQ(count.load(), 1);
+  int items = 0;
+  for (const std::atomic<int>& count : by_thread) items += count.load();
+  EXPECT_EQ(items, 103);
+  // Two blocks of 10: no more than two threads.
+  std::vector<std::atomic<int>> two_blocks(8);
+  forEachInParallel(8, 20, 10, [&](int t, int) { ++two_blocks[t]; });
+  for (int t = 2; t < 8; ++t) EXPECT_EQ(two_blocks[t].load(), 0) << "thread " << t;
+  forEachInParallel(4, 0, 10, [](int, int) { FAIL() << "no item to run"; });
+}
+
+// A thread that is held up takes fewer blocks: the others go on with the rest.
+TEST(ForEachInParallel, AThreadHeldUpTakesFewerBlocks) {
+  std::vector<std::atomic<int>> by_thread(2);
+  std::atomic<bool> released{false};
+  forEachInParallel(2, 100, 1, [&](int t, int) {
+    if (t == 0) {  // Held until the other thread has run every other item.
+      ++by_thread[0];
+      while (!released.load()) std::this_thread::yield();
+      return;
+    }
+    while (by_thread[0].load() == 0) std::this_thread::yield();
+    if (++by_thread[1] == 99) released = true;
+  });
+  EXPECT_EQ(by_thread[0].load(), 1);
+  EXPECT_EQ(by_thread[1].load(), 99);
+}
+
+TEST(ForEachInParallel, RethrowsAnItemsException) {
+  EXPECT_THROW(forEachInParallel(3, 50, 4,
+                                 [](int, int i) {
+                                   if (i == 37) throw std::runtime_error("item 37");
+                                 }),
+               std::runtime_error);
 }
 
 }  // namespace

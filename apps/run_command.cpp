@@ -69,7 +69,8 @@ void printProgress(const KeyframeStats& s, int frames) {
 
 // Loads the keyframes' images and runs their image stage (Pipeline::prepareImage), with
 // `ahead` one keyframe ahead on a second thread: keyframe k + 1's image stage then runs while
-// keyframe k's correspondence and local BA do, since it depends on the image alone. Only the
+// keyframe k's depth search, correspondence and local BA do (mostly beside the first two, which
+// take about as long), since it depends on the image alone. Only the
 // keyframes' images are read (selectKeyframes).
 class KeyframeImageFeed {
  public:

@@ -42,10 +42,10 @@ inline void forEachInParallel(int num_threads, int count, int block,
   if (count <= 0) return;
   block = std::max(block, 1);
   std::atomic<int> next{0};
-  const int threads = std::clamp((count + block - 1) / block, 1, std::max(num_threads, 1));
+  const int threads = std::clamp((count - 1) / block + 1, 1, std::max(num_threads, 1));
   runInParallel(threads, [&](int t) {
     for (int first = next.fetch_add(block); first < count; first = next.fetch_add(block)) {
-      const int last = std::min(count, first + block);
+      const int last = first + std::min(block, count - first);
       for (int i = first; i < last; ++i) work(t, i);
     }
   });

@@ -757,8 +757,8 @@ std::vector<ReferenceCandidate> rankReferenceFrames(
 
 namespace {
 
-// Below this many chain pixels a run is not worth a thread of its own (a search takes about 2 us
-// a pixel, a thread tens of us to start).
+// No run under this many chain pixels (a search takes about 2 us a pixel): a small keyframe then
+// starts fewer threads, each tens of us to start, than its few pixels would repay.
 constexpr std::size_t kMinPixelsPerRun = 256;
 
 // Where each of up to `runs` runs of consecutive chains starts, with about as many pixels each,
@@ -773,7 +773,7 @@ std::vector<std::size_t> splitByPixels(const std::vector<EdgeChain>& chains, std
     seen += chains[c].pixels.size();
     if (seen * runs >= total * first.size()) first.push_back(c + 1);
   }
-  first.push_back(chains.size());
+  if (first.back() != chains.size()) first.push_back(chains.size());  // No empty last run.
   return first;
 }
 

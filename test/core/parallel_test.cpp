@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace curvesfm {
@@ -51,21 +54,40 @@ TEST(ForEachInParallel, RunsEveryItemOnceOnNoMoreThreadsThanBlocks) {
   forEachInParallel(4, 0, 10, [](int, int) { FAIL() << "no item to run"; });
 }
 
-// A thread that is held up takes fewer blocks: the others go on with the rest.
+// A thread that is held up takes fewer blocks: the others go on with the rest. The waits give up
+// after 10 s, so that a fixed split fails the checks instead of hanging.
 TEST(ForEachInParallel, AThreadHeldUpTakesFewerBlocks) {
   std::vector<std::atomic<int>> by_thread(2);
   std::atomic<bool> released{false};
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  const auto wait_until = [&](const std::function<bool()>& done) {
+    while (!done() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+  };
   forEachInParallel(2, 100, 1, [&](int t, int) {
     if (t == 0) {  // Held until the other thread has run every other item.
       ++by_thread[0];
-      while (!released.load()) std::this_thread::yield();
+      wait_until([&] { return released.load(); });
       return;
     }
-    while (by_thread[0].load() == 0) std::this_thread::yield();
+    wait_until([&] { return by_thread[0].load() > 0; });
     if (++by_thread[1] == 99) released = true;
   });
   EXPECT_EQ(by_thread[0].load(), 1);
   EXPECT_EQ(by_thread[1].load(), 99);
+}
+
+// One thread, and a block larger than the items: every item once, on the calling thread.
+TEST(ForEachInParallel, OneThreadOrOneBlockRunsOnTheCallingThread) {
+  for (const auto& [threads, block] : {std::pair{1, 4}, std::pair{4, 64}}) {
+    std::vector<int> runs(10, 0);
+    const std::thread::id caller = std::this_thread::get_id();
+    forEachInParallel(threads, 10, block, [&](int t, int i) {
+      EXPECT_EQ(t, 0);
+      EXPECT_EQ(std::this_thread::get_id(), caller);
+      ++runs[i];
+    });
+    EXPECT_EQ(runs, std::vector<int>(10, 1)) << threads << " threads, block " << block;
+  }
 }
 
 TEST(ForEachInParallel, RethrowsAnItemsException) {

@@ -18,11 +18,12 @@ KeyframeImage prepareKeyframeImage(const cv::Mat& image_bgr, const ImageUndistor
   // A copy: undistort() returns its input unchanged when the camera has no distortion, and the
   // caller's buffer must not be shared with the map.
   prepared.image_bgr = undistorter.undistort(image_bgr).clone();
-  cv::cvtColor(prepared.image_bgr, prepared.grey, cv::COLOR_BGR2GRAY);
+  cv::Mat grey;
+  cv::cvtColor(prepared.image_bgr, grey, cv::COLOR_BGR2GRAY);
   prepared.undistort_seconds = secondsSince(start);
 
   start = Clock::now();
-  const EdgeImage edge_image = detectEdges(prepared.grey, edges, undistorter.validMask());
+  const EdgeImage edge_image = detectEdges(grey, edges, undistorter.validMask());
   prepared.chains = extractEdgeChains(edge_image, chains);
   prepared.edges = edge_image.edges;
   prepared.canny_low_threshold = edge_image.low_threshold;

@@ -17,10 +17,9 @@ namespace curvesfm {
 /// (issue 15: the frontend overlapped with BA).
 struct KeyframeImage {
   cv::Mat image_bgr;  ///< Undistorted, CV_8UC3.
-  cv::Mat grey;       ///< Undistorted, CV_8UC1.
-  /// What the depth search samples: `grey` after the edge detector's blur (EdgeImage::blurred),
-  /// CV_32FC1, converted once here, ahead, instead of for every keyframe that takes this one as
-  /// a depth reference.
+  /// What the depth search samples: the undistorted grey image after the edge detector's blur
+  /// (EdgeImage::blurred), CV_32FC1, converted once here, ahead, instead of for every keyframe that
+  /// takes this one as a depth reference.
   cv::Mat grey_float;
   cv::Mat edges;      ///< CV_8UC1, 255 at edge pixels (EdgeImage::edges).
   /// Canny hysteresis thresholds applied (grey levels / px), automatic or given.

@@ -1,12 +1,14 @@
 // frontend_edges_bench: the first stages of the image frontend on real photographs at 640 x 480.
 //
-// Images: home.jpg, building.jpg and fruits.jpg from OpenCV's sample data (--data-dir), each
-// resized to 640 x 480 (INTER_AREA) once, outside the timings; a missing file is skipped with a
-// message. Timed per image, on one thread (cv::setNumThreads(1)), default options:
+// Images: home.jpg, building.jpg and fruits.jpg from OpenCV's sample data (--data-dir), or the
+// files given with --images, each resized to 640 x 480 (INTER_AREA) once, outside the timings; a
+// missing photo is skipped with a message. Timed per image, on one thread (cv::setNumThreads(1)),
+// default options:
 //   undistort: ImageUndistorter::undistort with the TUM fr1 calibration (k1..k3 non-zero), the
 //              remap a distorted camera adds per keyframe (tables built once, not timed);
 //   edges:     detectEdges on the colour image (grey, blur, Sobel, automatic thresholds, Canny);
 //   chains:    extractEdgeChains on that result (thinning, junctions, tracing, curvature splits);
+//   field:     NearestEdgeField::build on the same edges (default reach);
 // plus edges_plus_chains, the per-keyframe cost without distortion.
 //
 // Output: `key: value` lines after one `#` header line; times are medians over --repeats after
@@ -16,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <opencv2/core.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -25,6 +28,7 @@
 
 #include "benchmarks/support/bench_common.h"
 #include "core/camera.h"
+#include "core/nearest_edge_field.h"
 #include "frontend/image/edge_chains.h"
 #include "frontend/image/edge_detector.h"
 #include "frontend/image/image_undistorter.h"
@@ -39,6 +43,8 @@ using bench::print;
 struct BenchOptions {
   int repeats = 21;  ///< Timed runs per stage and image; the median is reported; >= 1.
   std::string data_dir = "/usr/share/doc/opencv-doc/examples/data";  ///< Folder of the images.
+  /// Images to time instead of the three photos (any size: resized to 640 x 480).
+  std::vector<std::string> images;
 };
 
 // The TUM RGB-D fr1 calibration (Kinect 1 at 640 x 480), whose distortion is the strongest of
@@ -89,12 +95,16 @@ void runImage(const std::string& name, const cv::Mat& image, const ImageUndistor
       timeStage(repeats, [&] { cv::Mat out = undistorter.undistort(image); });
   const StageTime edge_time = timeStage(repeats, [&] { edges = detectEdges(image); });
   const StageTime chain_time = timeStage(repeats, [&] { chains = extractEdgeChains(edges); });
+  const StageTime field_time = timeStage(repeats, [&] {
+    const NearestEdgeField field = NearestEdgeField::build(edges.edges, edges.grad_x, edges.grad_y);
+  });
   long long chain_pixels = 0;
   for (const EdgeChain& chain : chains) chain_pixels += static_cast<long long>(chain.pixels.size());
   const double pixels = static_cast<double>(image.total());
   printStage("undistort", name, undistort);
   printStage("edges", name, edge_time);
   printStage("chains", name, chain_time);
+  printStage("field", name, field_time);
   printStage("edges_plus_chains", name,
              {edge_time.wall_ms + chain_time.wall_ms, edge_time.cpu_ms + chain_time.cpu_ms});
   print("high_threshold_" + name, edges.high_threshold);
@@ -107,14 +117,25 @@ void runImage(const std::string& name, const cv::Mat& image, const ImageUndistor
 int run(const BenchOptions& bench) {
   cv::setNumThreads(1);
   std::printf(
-      "# frontend_edges_bench: undistort, detectEdges and extractEdgeChains (default options) on "
-      "photos resized to 640x480, one thread; medians of %d repeats\n",
+      "# frontend_edges_bench: undistort, detectEdges, extractEdgeChains and the nearest-edge "
+      "field "
+      "(default options) on images resized to 640x480, one thread; medians of %d repeats\n",
       bench.repeats);
   const ImageUndistorter undistorter(tumFreiburg1());
   int measured = 0;
-  for (const std::string name : {"home", "building", "fruits"}) {
-    const std::string path = bench.data_dir + "/" + name + ".jpg";
+  std::vector<std::string> paths = bench.images;
+  if (paths.empty()) {
+    for (const std::string name : {"home", "building", "fruits"})
+      paths.push_back(bench.data_dir + "/" + name + ".jpg");
+  }
+  for (const std::string& path : paths) {
+    const std::string name = std::filesystem::path(path).stem().string();
     const cv::Mat photo = cv::imread(path, cv::IMREAD_COLOR);
+    if (photo.empty() && !bench.images.empty()) {
+      std::fprintf(stderr, "frontend_edges_bench: %s: not an image OpenCV can read\n",
+                   path.c_str());
+      return 1;
+    }
     if (photo.empty()) {
       std::printf("# skipped %s: not found or not readable\n", path.c_str());
       continue;
@@ -140,5 +161,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--data-dir", bench.data_dir, "Folder holding home.jpg, building.jpg, fruits.jpg")
       ->capture_default_str();
+  app.add_option("--images", bench.images,
+                 "Images to time instead of the three photos (resized to 640x480)")
+      ->check(CLI::ExistingFile);
   return curvesfm::bench::parseAndRun(app, argc, argv, [&] { return curvesfm::run(bench); });
 }

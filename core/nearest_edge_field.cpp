@@ -414,7 +414,8 @@ class DistanceSweep {
         site_(width),
         site_start_(width),
         site_value_(width),
-        owner_(width) {
+        owner_(width),
+        row_out_(width) {
     // Each column's first edge pixel, and each edge pixel's successor in its column.
     for (int row = height; row-- > 0;) {
       for (int e = row_start_[row + 1]; e-- > row_start_[row];) {
@@ -427,9 +428,14 @@ class DistanceSweep {
     }
   }
 
-  void run(std::int32_t* index) {
+  // Hands each row's nearest edge pixels (index into the layout's edge pixels, or -1 beyond R)
+  // to store(row, values) as it is done: one row of scratch, so that the caller keeps only the
+  // index width it needs (most fields keep two bytes a pixel, and a full-size four-byte
+  // temporary was a megabyte of fresh memory per 640 x 480 keyframe).
+  template <class Store>
+  void run(Store store) {
+    std::int32_t* out = row_out_.data();
     for (int row = 0; row < height_; ++row) {
-      std::int32_t* out = index + static_cast<std::size_t>(row) * width_;
       const int first = row_start_[row];
       const int last = row_start_[row + 1];
       for (int e = first; e < last; ++e) {
@@ -442,6 +448,7 @@ class DistanceSweep {
       } else {
         std::fill(out, out + width_, -1);
       }
+      store(row, static_cast<const std::int32_t*>(out));
       for (int e = first; e < last; ++e) {
         down_index_[column_[e]] = next_in_column_[e];
         down_row_[column_[e]] = next_row_[e];
@@ -642,6 +649,7 @@ class DistanceSweep {
   std::vector<std::int32_t> site_start_;
   std::vector<std::int32_t> site_value_;
   std::vector<std::int32_t> owner_;
+  std::vector<std::int32_t> row_out_;  // The row being swept.
 };
 
 }  // namespace
@@ -673,16 +681,22 @@ NearestEdgeField NearestEdgeField::build(const cv::Mat& edges, const cv::Mat& gr
   const EdgeLayout layout = grad_x.type() == CV_16SC1
                                 ? collectEdges<std::int16_t>(edges, grad_x, grad_y, &field.edges_)
                                 : collectEdges<float>(edges, grad_x, grad_y, &field.edges_);
-  field.wide_index_.resize(static_cast<std::size_t>(field.width_) * field.height_);
-  DistanceSweep(layout, field.width_, field.height_, options.max_distance_px)
-      .run(field.wide_index_.data());
+  const std::size_t pixels = static_cast<std::size_t>(field.width_) * field.height_;
+  const std::size_t width = static_cast<std::size_t>(field.width_);
+  DistanceSweep sweep(layout, field.width_, field.height_, options.max_distance_px);
   if (field.edges_.size() < kNoNarrowIndex) {
-    field.narrow_index_.resize(field.wide_index_.size());
-    std::transform(field.wide_index_.begin(), field.wide_index_.end(), field.narrow_index_.begin(),
-                   [](std::int32_t index) {
-                     return index < 0 ? kNoNarrowIndex : static_cast<std::uint16_t>(index);
-                   });
-    decltype(field.wide_index_)().swap(field.wide_index_);
+    field.narrow_index_.resize(pixels);
+    sweep.run([&](int row, const std::int32_t* values) {
+      std::transform(values, values + width, field.narrow_index_.data() + row * width,
+                     [](std::int32_t index) {
+                       return index < 0 ? kNoNarrowIndex : static_cast<std::uint16_t>(index);
+                     });
+    });
+  } else {
+    field.wide_index_.resize(pixels);
+    sweep.run([&](int row, const std::int32_t* values) {
+      std::copy(values, values + width, field.wide_index_.data() + row * width);
+    });
   }
   return field;
 }

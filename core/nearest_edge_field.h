@@ -141,7 +141,7 @@ class NearestEdgeField {
   // the image has fewer edge pixels than that, which halves the field of a real image; else four
   // (-1 beyond R). Exactly one of the two is filled.
   static constexpr std::uint16_t kNoNarrowIndex = 0xFFFF;
-  std::vector<std::uint16_t> narrow_index_;
+  std::vector<std::uint16_t, UninitialisedAllocator<std::uint16_t>> narrow_index_;
   std::vector<std::int32_t, UninitialisedAllocator<std::int32_t>> wide_index_;
   std::vector<EdgePixel> edges_;
 };

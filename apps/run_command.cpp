@@ -969,136 +969,40 @@ RunInput RunCommand::loadInput() const {
   return input;
 }
 
-int RunCommand::run() const {
-  validate();
-  const Clock::time_point start = Clock::now();
-  const RunInput input = loadInput();
-  const ImageSequence& d = input.sequence;
-  if (input.initialisation && input.frames.size() < 2) {
-    std::fflush(stdout);  // The initialiser's summary first, then why the run stops.
-    std::fprintf(stderr, "run: the initialiser registered %zu frames: nothing to refine (%s)\n",
-                 input.frames.size(), input.initialisation->failure.c_str());
-    return 1;
-  }
-  createOutputFolder(out_dir_);
-  std::printf("run: %s (%s layout), %zu of %zu images with an initial pose (%s), camera %dx%d\n",
-              dataset_dir_.c_str(), d.layout.c_str(), input.frames.size(), d.images.size(),
-              input.init_poses_source.c_str(), d.camera.width(), d.camera.height());
-
-  PipelineOptions options = options_;
-  const std::optional<StartModelEstimate> start_model =
-      readStartModel(input, start_model_, &options);
-  options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
-  std::unique_ptr<Pipeline> pipeline;
+// The pipeline's result and what decided how it ran.
+struct RunOutcome {
+  std::unique_ptr<Pipeline> pipeline;  // The last pass's, for its camera and overlays.
   PipelineResult result;
-  const bool tied_start = options.ba.start_prior && !options_.ba.start_prior;
-  const int relift_passes = std::max(relift_passes_, tied_start ? start_model_.relift_passes : 0);
-  std::vector<Pose3> frontend_poses = input.frontend_poses;
+  PipelineOptions options;  // As run: the start model may have tied the start per pose.
+  std::optional<StartModelEstimate> start_model;
+  bool tied_start = false;
+  int relift_passes = 0;
   double image_wait_seconds = 0.0;
-  for (int pass = 0; pass <= relift_passes; ++pass) {
-    if (pass > 0) {
-      printReliftPass(pass, relift_passes, evaluateAte(result, d));
-      frontend_poses = reliftPoses(input, frontend_poses, result);
-    }
-    pipeline = std::make_unique<Pipeline>(d.camera, options);
-    image_wait_seconds += feedFrames(pipeline.get(), input, frontend_poses, options, images_ahead_);
-    result = pipeline->finish();
-  }
-  const AteResult ate = evaluateAte(result, d);
-  const std::vector<StageMotion> motions = stageMotions(result, d);
-  const std::map<std::string, FactorTypeCost> fit = finalFit(result);
+};
 
-  writeTrajectory(joinPath(out_dir_, "trajectory.txt"),
-                  stampedPoses(result.keyframe_timestamps, result.keyframe_cam_from_world));
-  writeTrajectory(joinPath(out_dir_, "trajectory_initial.txt"),
-                  stampedPoses(result.keyframe_timestamps, result.keyframe_initial_cam_from_world));
-  if (input.initialisation) {
-    // The hybrid graph refined the points with the curves; else they are the initialiser's.
-    writeInitialisedPoints(joinPath(out_dir_, "points.ply"), *input.initialisation,
-                           result.points.empty() ? nullptr : &result.points);
-  }
-  const CurveExport exported =
-      selectExportedCurves(result.curves, result.curve_statistics, export_min_epipolar_angle_deg_);
-  writeCurvesPly(joinPath(out_dir_, "curves.ply"), exported.curves, export_samples_per_segment_);
-  writeCurvesObj(joinPath(out_dir_, "curves.obj"), exported.curves, export_samples_per_segment_,
-                 exported.ids);
-  writeCurveStatisticsCsv(joinPath(out_dir_, "curves.csv"), result.curve_statistics,
-                          exported.flags);
-  writeConfigYaml(joinPath(out_dir_, "config.yaml"), *command_);
+// The refined trajectory against the ground truth, and how well the images agree with it.
+struct RunEvaluation {
+  AteResult ate;
+  std::vector<StageMotion> motions;
+  std::map<std::string, FactorTypeCost> fit;
+};
+
+// What the output folder received beyond the fixed files.
+struct WrittenOutputs {
+  CurveExport exported;
   int overlays = 0;
   int worst_curve_images = 0;
-  if (overlays_) {
-    const OverlayScene scene = overlayScene(*pipeline, result);
-    overlays = writeOverlays(joinPath(out_dir_, "overlays"), scene, overlay_,
-                             overlay_colouring_.colour_by);
-    worst_curve_images = writeWorstCurves(joinPath(out_dir_, "worst_curves"), scene, overlay_);
-  }
+};
 
-  nlohmann::json frames = nlohmann::json::array();
-  for (const KeyframeStats& s : result.frames) frames.push_back(frameToJson(s));
-  const double seconds = secondsSince(start);
-  const CurveGrowth growth = curveGrowth(result.frames);
-  writeJsonFile(
-      joinPath(out_dir_, "report.json"),
-      {{"command", "run"},
-       {"curvesfm", versionJson()},
-       {"config", optionsToJson(*command_)},
-       {"options", runOptionsJson()},
-       {"dataset",
-        {{"dir", dataset_dir_},
-         {"layout", d.layout},
-         {"camera", d.camera_source},
-         {"init_poses", input.init_poses_source},
-         {"groundtruth", d.ground_truth_source},
-         {"images", d.images.size()},
-         {"frames_with_initial_pose", input.frames.size()}}},
-       {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
-                                            : nlohmann::json(nullptr)},
-       {"camera", cameraToJson(pipeline->undistortedCamera())},
-       {"start_model", startModelJson(start_model, tied_start, options.ba)},
-       {"relift_passes_run", relift_passes},
-       {"reassociation_rounds_allowed", options.reassociation_rounds},
-       {"scene_scale", result.scene_scale},
-       {"counts",
-        {{"frames", input.frames.size()},
-         {"keyframes", result.keyframe_cam_from_world.size()},
-         {"curves", result.curves.size()},
-         {"segments", totalSegments(result.curves)},
-         {"curves_exported", exported.ids.size()},
-         {"curves_started", growth.started},
-         {"curves_extended", growth.extended},
-         {"segments_registered", growth.registered},
-         {"registrations_rejected", growth.rejected},
-         {"registrations_rejected_edge_distance", growth.rejected_edge_distance},
-         {"overlays", overlays},
-         {"worst_curve_images", worst_curve_images}}},
-       {"frames", frames},
-       {"global_ba", scheduleReportToJson(result.global_ba)},
-       {"global_ba_cost_by_type", globalCostsToJson(result.global_ba)},
-       {"reassociation", reassociationToJson(result.reassociation)},
-       {"final_fit", costsToJson(fit)},
-       {"final_samples", sampleCountsToJson(result.final_samples)},
-       {"ate", ateToJson(ate)},
-       {"pose_stages", stageMotionsJson(motions, result.scene_scale)},
-       {"curve_statistics", curveStatisticsJson(result.curve_statistics)},
-       {"sanity", sanityToJson(result.sanity)},
-       {"total_seconds", seconds},
-       {"image_wait_seconds", image_wait_seconds},
-       {"peak_memory_mib", peakResidentMiB()}});
+namespace {
 
-  printSummary(input, result, seconds, images_ahead_ ? image_wait_seconds : -1.0);
-  printAte(ate, d.ground_truth_source);
-  printStageMotions(motions);
-  printFinalFit(fit);
-  printCurveStatistics(result.curve_statistics);
-  printExport(exported, result.curves.size(), export_min_epipolar_angle_deg_);
-  printSanity(result.sanity);
-  std::printf(
-      "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, curves.csv, "
-      "report.json, "
-      "config.yaml%s%s)\n",
-      out_dir_.c_str(), input.initialisation ? ", points.ply" : "",
-      overlays_ ? ", overlays/, worst_curves/" : "");
+RunEvaluation evaluateRun(const PipelineResult& result, const ImageSequence& sequence) {
+  return {evaluateAte(result, sequence), stageMotions(result, sequence), finalFit(result)};
+}
+
+// The process's exit status: 1 when nothing plausible was reconstructed or a global BA failed,
+// each with one line on stderr after the summary.
+int exitStatus(const PipelineResult& result) {
   std::fflush(stdout);  // The summary first, then why the run failed, if it did.
   if (result.curves.empty() && result.sanity.droppedCurves() > 0) {
     std::fprintf(stderr,
@@ -1124,6 +1028,164 @@ int RunCommand::run() const {
     }
   }
   return 0;
+}
+
+}  // namespace
+
+int RunCommand::run() const {
+  validate();
+  const Clock::time_point start = Clock::now();
+  const RunInput input = loadInput();
+  const ImageSequence& d = input.sequence;
+  if (input.initialisation && input.frames.size() < 2) {
+    std::fflush(stdout);  // The initialiser's summary first, then why the run stops.
+    std::fprintf(stderr, "run: the initialiser registered %zu frames: nothing to refine (%s)\n",
+                 input.frames.size(), input.initialisation->failure.c_str());
+    return 1;
+  }
+  createOutputFolder(out_dir_);
+  std::printf("run: %s (%s layout), %zu of %zu images with an initial pose (%s), camera %dx%d\n",
+              dataset_dir_.c_str(), d.layout.c_str(), input.frames.size(), d.images.size(),
+              input.init_poses_source.c_str(), d.camera.width(), d.camera.height());
+  const RunOutcome outcome = refine(input);
+  const RunEvaluation evaluation = evaluateRun(outcome.result, d);
+  const WrittenOutputs written = writeOutputs(input, outcome);
+  const double seconds = secondsSince(start);
+  writeJsonFile(joinPath(out_dir_, "report.json"),
+                reportJson(input, outcome, evaluation, written, seconds));
+  printResults(input, outcome, evaluation, written, seconds);
+  return exitStatus(outcome.result);
+}
+
+// Reads how the start is to be held, then runs the pipeline once, and once more per relift pass
+// at the previous pass's refined poses.
+RunOutcome RunCommand::refine(const RunInput& input) const {
+  RunOutcome outcome;
+  outcome.options = options_;
+  outcome.start_model = readStartModel(input, start_model_, &outcome.options);
+  outcome.options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
+  outcome.tied_start = outcome.options.ba.start_prior && !options_.ba.start_prior;
+  outcome.relift_passes =
+      std::max(relift_passes_, outcome.tied_start ? start_model_.relift_passes : 0);
+  std::vector<Pose3> frontend_poses = input.frontend_poses;
+  for (int pass = 0; pass <= outcome.relift_passes; ++pass) {
+    if (pass > 0) {
+      printReliftPass(pass, outcome.relift_passes, evaluateAte(outcome.result, input.sequence));
+      frontend_poses = reliftPoses(input, frontend_poses, outcome.result);
+    }
+    outcome.pipeline = std::make_unique<Pipeline>(input.sequence.camera, outcome.options);
+    outcome.image_wait_seconds +=
+        feedFrames(outcome.pipeline.get(), input, frontend_poses, outcome.options, images_ahead_);
+    outcome.result = outcome.pipeline->finish();
+  }
+  return outcome;
+}
+
+// Trajectories, points, curves with their statistics, config.yaml and, with --overlays, the
+// overlays and the worst curves.
+WrittenOutputs RunCommand::writeOutputs(const RunInput& input, const RunOutcome& outcome) const {
+  const PipelineResult& result = outcome.result;
+  writeTrajectory(joinPath(out_dir_, "trajectory.txt"),
+                  stampedPoses(result.keyframe_timestamps, result.keyframe_cam_from_world));
+  writeTrajectory(joinPath(out_dir_, "trajectory_initial.txt"),
+                  stampedPoses(result.keyframe_timestamps, result.keyframe_initial_cam_from_world));
+  if (input.initialisation) {
+    // The hybrid graph refined the points with the curves; else they are the initialiser's.
+    writeInitialisedPoints(joinPath(out_dir_, "points.ply"), *input.initialisation,
+                           result.points.empty() ? nullptr : &result.points);
+  }
+  WrittenOutputs written;
+  written.exported =
+      selectExportedCurves(result.curves, result.curve_statistics, export_min_epipolar_angle_deg_);
+  const CurveExport& exported = written.exported;
+  writeCurvesPly(joinPath(out_dir_, "curves.ply"), exported.curves, export_samples_per_segment_);
+  writeCurvesObj(joinPath(out_dir_, "curves.obj"), exported.curves, export_samples_per_segment_,
+                 exported.ids);
+  writeCurveStatisticsCsv(joinPath(out_dir_, "curves.csv"), result.curve_statistics,
+                          exported.flags);
+  writeConfigYaml(joinPath(out_dir_, "config.yaml"), *command_);
+  if (overlays_) {
+    const OverlayScene scene = overlayScene(*outcome.pipeline, result);
+    written.overlays = writeOverlays(joinPath(out_dir_, "overlays"), scene, overlay_,
+                                     overlay_colouring_.colour_by);
+    written.worst_curve_images =
+        writeWorstCurves(joinPath(out_dir_, "worst_curves"), scene, overlay_);
+  }
+  return written;
+}
+
+nlohmann::json RunCommand::reportJson(const RunInput& input, const RunOutcome& outcome,
+                                      const RunEvaluation& evaluation,
+                                      const WrittenOutputs& written, double seconds) const {
+  const ImageSequence& d = input.sequence;
+  const PipelineResult& result = outcome.result;
+  nlohmann::json frames = nlohmann::json::array();
+  for (const KeyframeStats& s : result.frames) frames.push_back(frameToJson(s));
+  const CurveGrowth growth = curveGrowth(result.frames);
+  return {
+      {"command", "run"},
+      {"curvesfm", versionJson()},
+      {"config", optionsToJson(*command_)},
+      {"options", runOptionsJson()},
+      {"dataset",
+       {{"dir", dataset_dir_},
+        {"layout", d.layout},
+        {"camera", d.camera_source},
+        {"init_poses", input.init_poses_source},
+        {"groundtruth", d.ground_truth_source},
+        {"images", d.images.size()},
+        {"frames_with_initial_pose", input.frames.size()}}},
+      {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
+                                           : nlohmann::json(nullptr)},
+      {"camera", cameraToJson(outcome.pipeline->undistortedCamera())},
+      {"start_model", startModelJson(outcome.start_model, outcome.tied_start, outcome.options.ba)},
+      {"relift_passes_run", outcome.relift_passes},
+      {"reassociation_rounds_allowed", outcome.options.reassociation_rounds},
+      {"scene_scale", result.scene_scale},
+      {"counts",
+       {{"frames", input.frames.size()},
+        {"keyframes", result.keyframe_cam_from_world.size()},
+        {"curves", result.curves.size()},
+        {"segments", totalSegments(result.curves)},
+        {"curves_exported", written.exported.ids.size()},
+        {"curves_started", growth.started},
+        {"curves_extended", growth.extended},
+        {"segments_registered", growth.registered},
+        {"registrations_rejected", growth.rejected},
+        {"registrations_rejected_edge_distance", growth.rejected_edge_distance},
+        {"overlays", written.overlays},
+        {"worst_curve_images", written.worst_curve_images}}},
+      {"frames", frames},
+      {"global_ba", scheduleReportToJson(result.global_ba)},
+      {"global_ba_cost_by_type", globalCostsToJson(result.global_ba)},
+      {"reassociation", reassociationToJson(result.reassociation)},
+      {"final_fit", costsToJson(evaluation.fit)},
+      {"final_samples", sampleCountsToJson(result.final_samples)},
+      {"ate", ateToJson(evaluation.ate)},
+      {"pose_stages", stageMotionsJson(evaluation.motions, result.scene_scale)},
+      {"curve_statistics", curveStatisticsJson(result.curve_statistics)},
+      {"sanity", sanityToJson(result.sanity)},
+      {"total_seconds", seconds},
+      {"image_wait_seconds", outcome.image_wait_seconds},
+      {"peak_memory_mib", peakResidentMiB()}};
+}
+
+void RunCommand::printResults(const RunInput& input, const RunOutcome& outcome,
+                              const RunEvaluation& evaluation, const WrittenOutputs& written,
+                              double seconds) const {
+  const PipelineResult& result = outcome.result;
+  printSummary(input, result, seconds, images_ahead_ ? outcome.image_wait_seconds : -1.0);
+  printAte(evaluation.ate, input.sequence.ground_truth_source);
+  printStageMotions(evaluation.motions);
+  printFinalFit(evaluation.fit);
+  printCurveStatistics(result.curve_statistics);
+  printExport(written.exported, result.curves.size(), export_min_epipolar_angle_deg_);
+  printSanity(result.sanity);
+  std::printf(
+      "written: %s (trajectory.txt, trajectory_initial.txt, curves.ply, curves.obj, curves.csv, "
+      "report.json, config.yaml%s%s)\n",
+      out_dir_.c_str(), input.initialisation ? ", points.ply" : "",
+      overlays_ ? ", overlays/, worst_curves/" : "");
 }
 
 }  // namespace curvesfm

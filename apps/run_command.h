@@ -14,6 +14,9 @@
 namespace curvesfm {
 
 struct RunInput;
+struct RunOutcome;
+struct RunEvaluation;
+struct WrittenOutputs;
 
 /// `curvesfm run`: the incremental curve SfM pipeline on a dataset in any layout of
 /// loadImageSequence (README "Dataset layouts"): takes the initial poses from --init-poses (a TUM
@@ -44,6 +47,16 @@ class RunCommand {
   std::vector<Pose3> frontendPoses(const RunInput& input) const;
   /// Every option in force, for report.json: the table's and the run's own.
   nlohmann::json runOptionsJson() const;
+  /// The pipeline over the input, once more per relift pass.
+  RunOutcome refine(const RunInput& input) const;
+  WrittenOutputs writeOutputs(const RunInput& input, const RunOutcome& outcome) const;
+  nlohmann::json reportJson(const RunInput& input, const RunOutcome& outcome,
+                            const RunEvaluation& evaluation, const WrittenOutputs& written,
+                            double seconds) const;
+  /// The summary lines after the run.
+  void printResults(const RunInput& input, const RunOutcome& outcome,
+                    const RunEvaluation& evaluation, const WrittenOutputs& written,
+                    double seconds) const;
 
   CLI::App* command_;
   std::string dataset_dir_;

@@ -335,65 +335,84 @@ int EvalMapCommand::run() const {
   const std::string curves_path = curvesPath();
   Polylines3 estimate = readCurveMap(curves_path);
   const Polylines3 ground_truth = readCurveMap(ground_truth_curves_path_);
-
-  const bool align = alignment_.alignment != AlignmentKind::kNone;
-  std::optional<ImageSequence> sequence;
-  if ((align && ground_truth_trajectory_path_.empty()) || edge_coverage_) {
-    sequence = loadImageSequence(dataset_dir_, sequence_);
-    if (sequence->ground_truth.empty()) {
-      throw IoError(dataset_dir_, edge_coverage_
-                                      ? "has no ground-truth trajectory to project the "
-                                        "ground-truth curves with (--edge-coverage)"
-                                      : "has no ground-truth trajectory to align the estimate "
-                                        "with (give --gt-trajectory, or --align none)");
-    }
-  }
+  const std::optional<ImageSequence> sequence = sequenceIfNeeded();
   // The images at their ground-truth poses, for the edge coverage.
   const std::vector<DatasetFrame> frames =
       edge_coverage_ ? framesWithPoses(*sequence, sequence->ground_truth, alignment_.max_dt,
                                        sequence->ground_truth_source)
                      : std::vector<DatasetFrame>();
-
-  std::optional<TrajectoryEvaluation> alignment;
-  double frames_axis_length = 0.0;  // > 0: aligned by camera frames, their axes this long.
-  std::string ground_truth_source = ground_truth_trajectory_path_;
-  if (align) {
-    const std::string trajectory_path = trajectoryPath();
-    const std::vector<StampedPose> trajectory = readTrajectory(trajectory_path);
-    std::vector<StampedPose> ground_truth_trajectory;
-    if (!ground_truth_trajectory_path_.empty()) {
-      ground_truth_trajectory = readTrajectory(ground_truth_trajectory_path_);
-    } else {
-      ground_truth_trajectory = sequence->ground_truth;
-      ground_truth_source = sequence->ground_truth_source;
-    }
-    alignment = compareTrajectories(trajectory, ground_truth_trajectory, alignment_,
-                                    trajectory_path, ground_truth_source);
-    if (align_frames_ && alignment_.alignment == AlignmentKind::kSim3) {
-      frames_axis_length = alignByCameraFrames(trajectory, ground_truth, &*alignment);
-    }
-    const Sim3& gt_from_estimate = alignment->ground_truth_from_estimate;
-    for (auto& polyline : estimate) {
-      for (Eigen::Vector3d& p : polyline) p = gt_from_estimate * p;
-    }
-    std::printf(
-        "alignment %s of %s onto %s: %zu matched poses, ATE rmse %.6f; scale %.6f, translation "
-        "[%.6f, %.6f, %.6f]\n",
-        toString(alignment_.alignment).c_str(), trajectory_path.c_str(),
-        ground_truth_source.c_str(), alignment->matches.size(), alignment->ate.rmse,
-        gt_from_estimate.scale, gt_from_estimate.translation.x(), gt_from_estimate.translation.y(),
-        gt_from_estimate.translation.z());
-    if (frames_axis_length > 0.0) {
-      std::printf(
-          "  fitted to the camera frames (centres and axes %.4g long, the cameras' median distance "
-          "to the ground-truth curves; the ATE is the centres' own fit)\n",
-          frames_axis_length);
-    }
-  } else {
-    std::printf("alignment none: the curves are taken in the ground truth's frame as they are\n");
-  }
+  const MapAlignment alignment = alignEstimate(sequence, ground_truth, &estimate);
 
   const CurveMapEvaluation e = evaluateCurveMap(estimate, ground_truth, options_);
+  printEvaluation(curves_path, e);
+  const nlohmann::json edge_coverage =
+      edge_coverage_
+          ? reportEdgeCoverage(estimate, ground_truth, frames, *sequence, 10.0 * e.sample_spacing)
+          : nlohmann::json(nullptr);
+  if (!json_path_.empty()) writeJsonReport(curves_path, e, alignment, edge_coverage);
+  return 0;
+}
+
+std::optional<ImageSequence> EvalMapCommand::sequenceIfNeeded() const {
+  const bool align = alignment_.alignment != AlignmentKind::kNone;
+  if (!(align && ground_truth_trajectory_path_.empty()) && !edge_coverage_) return std::nullopt;
+  ImageSequence sequence = loadImageSequence(dataset_dir_, sequence_);
+  if (sequence.ground_truth.empty()) {
+    throw IoError(dataset_dir_, edge_coverage_
+                                    ? "has no ground-truth trajectory to project the "
+                                      "ground-truth curves with (--edge-coverage)"
+                                    : "has no ground-truth trajectory to align the estimate "
+                                      "with (give --gt-trajectory, or --align none)");
+  }
+  return sequence;
+}
+
+MapAlignment EvalMapCommand::alignEstimate(const std::optional<ImageSequence>& sequence,
+                                           const Polylines3& ground_truth,
+                                           Polylines3* estimate) const {
+  MapAlignment aligned;
+  aligned.ground_truth_source = ground_truth_trajectory_path_;
+  if (alignment_.alignment == AlignmentKind::kNone) {
+    std::printf("alignment none: the curves are taken in the ground truth's frame as they are\n");
+    return aligned;
+  }
+  const std::string trajectory_path = trajectoryPath();
+  const std::vector<StampedPose> trajectory = readTrajectory(trajectory_path);
+  std::vector<StampedPose> ground_truth_trajectory;
+  if (!ground_truth_trajectory_path_.empty()) {
+    ground_truth_trajectory = readTrajectory(ground_truth_trajectory_path_);
+  } else {
+    ground_truth_trajectory = sequence->ground_truth;
+    aligned.ground_truth_source = sequence->ground_truth_source;
+  }
+  aligned.evaluation = compareTrajectories(trajectory, ground_truth_trajectory, alignment_,
+                                           trajectory_path, aligned.ground_truth_source);
+  TrajectoryEvaluation& evaluation = *aligned.evaluation;
+  if (align_frames_ && alignment_.alignment == AlignmentKind::kSim3) {
+    aligned.frames_axis_length = alignByCameraFrames(trajectory, ground_truth, &evaluation);
+  }
+  const Sim3& gt_from_estimate = evaluation.ground_truth_from_estimate;
+  for (auto& polyline : *estimate) {
+    for (Eigen::Vector3d& p : polyline) p = gt_from_estimate * p;
+  }
+  std::printf(
+      "alignment %s of %s onto %s: %zu matched poses, ATE rmse %.6f; scale %.6f, translation "
+      "[%.6f, %.6f, %.6f]\n",
+      toString(alignment_.alignment).c_str(), trajectory_path.c_str(),
+      aligned.ground_truth_source.c_str(), evaluation.matches.size(), evaluation.ate.rmse,
+      gt_from_estimate.scale, gt_from_estimate.translation.x(), gt_from_estimate.translation.y(),
+      gt_from_estimate.translation.z());
+  if (aligned.frames_axis_length > 0.0) {
+    std::printf(
+        "  fitted to the camera frames (centres and axes %.4g long, the cameras' median distance "
+        "to the ground-truth curves; the ATE is the centres' own fit)\n",
+        aligned.frames_axis_length);
+  }
+  return aligned;
+}
+
+void EvalMapCommand::printEvaluation(const std::string& curves_path,
+                                     const CurveMapEvaluation& e) const {
   std::printf("estimate %s: %d polylines, length %.4f\n", curves_path.c_str(), e.estimate_polylines,
               e.estimate_length);
   std::printf("ground truth %s (%s): %d polylines, length %.4f\n",
@@ -415,36 +434,35 @@ int EvalMapCommand::run() const {
       "units)\n",
       e.sample_spacing);
   printScores(e);
-  const nlohmann::json edge_coverage =
-      edge_coverage_
-          ? reportEdgeCoverage(estimate, ground_truth, frames, *sequence, 10.0 * e.sample_spacing)
-          : nlohmann::json(nullptr);
+}
 
-  if (!json_path_.empty()) {
-    nlohmann::json report = evaluationToJson(e);
-    report["command"] = "eval-map";
-    report["curvesfm"] = versionJson();
-    report["config"] = optionsToJson(*command_);
-    report["options"] = table_.toJson();
-    report["inputs"] = {
-        {"curves", curves_path},
-        {"ground_truth_curves", ground_truth_curves_path_},
-        {"ground_truth_format", toString(detectCurveMapFormat(ground_truth_curves_path_))}};
-    report["edge_coverage"] = edge_coverage;
-    report["alignment"] = nullptr;
-    if (alignment) {
-      report["inputs"]["trajectory"] = trajectoryPath();
-      report["inputs"]["ground_truth_trajectory"] = ground_truth_source;
-      report["alignment"] = alignmentToJson(*alignment);
-      report["alignment"]["matched"] = alignment->matches.size();
-      report["alignment"]["ate"] = statisticsToJson(alignment->ate);
-      report["alignment"]["frames_axis_length"] =
-          frames_axis_length > 0.0 ? nlohmann::json(frames_axis_length) : nlohmann::json(nullptr);
-    }
-    writeJsonFile(json_path_, report);
-    std::printf("json: %s\n", json_path_.c_str());
+void EvalMapCommand::writeJsonReport(const std::string& curves_path, const CurveMapEvaluation& e,
+                                     const MapAlignment& alignment,
+                                     const nlohmann::json& edge_coverage) const {
+  nlohmann::json report = evaluationToJson(e);
+  report["command"] = "eval-map";
+  report["curvesfm"] = versionJson();
+  report["config"] = optionsToJson(*command_);
+  report["options"] = table_.toJson();
+  report["inputs"] = {
+      {"curves", curves_path},
+      {"ground_truth_curves", ground_truth_curves_path_},
+      {"ground_truth_format", toString(detectCurveMapFormat(ground_truth_curves_path_))}};
+  report["edge_coverage"] = edge_coverage;
+  report["alignment"] = nullptr;
+  if (alignment.evaluation) {
+    const TrajectoryEvaluation& evaluation = *alignment.evaluation;
+    report["inputs"]["trajectory"] = trajectoryPath();
+    report["inputs"]["ground_truth_trajectory"] = alignment.ground_truth_source;
+    report["alignment"] = alignmentToJson(evaluation);
+    report["alignment"]["matched"] = evaluation.matches.size();
+    report["alignment"]["ate"] = statisticsToJson(evaluation.ate);
+    report["alignment"]["frames_axis_length"] = alignment.frames_axis_length > 0.0
+                                                    ? nlohmann::json(alignment.frames_axis_length)
+                                                    : nlohmann::json(nullptr);
   }
-  return 0;
+  writeJsonFile(json_path_, report);
+  std::printf("json: %s\n", json_path_.c_str());
 }
 
 }  // namespace curvesfm

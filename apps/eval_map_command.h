@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "apps/cli/options_table.h"
@@ -21,6 +22,13 @@ namespace curvesfm {
 /// TUM file; `--align none` takes the curves as they are. Prints a table per tau and writes every
 /// figure and option as JSON. With `--edge-coverage`, also how much of the ground truth the
 /// dataset's images show as edges (frontend/image/edge_coverage.h) and the recall on that part.
+/// The estimate's alignment onto the ground truth, when one was asked for.
+struct MapAlignment {
+  std::optional<TrajectoryEvaluation> evaluation;  ///< Empty with --align none.
+  double frames_axis_length = 0.0;  ///< > 0: fitted to the camera frames, axes this long.
+  std::string ground_truth_source;  ///< The ground-truth trajectory's file.
+};
+
 class EvalMapCommand {
  public:
   explicit EvalMapCommand(CLI::App* app);
@@ -38,6 +46,16 @@ class EvalMapCommand {
  private:
   std::string curvesPath() const;
   std::string trajectoryPath() const;
+  /// The dataset, when the alignment or --edge-coverage needs its ground truth; IoError if it
+  /// has none.
+  std::optional<ImageSequence> sequenceIfNeeded() const;
+  /// Aligns the run's trajectory onto the ground truth's and moves `estimate` with it, printing
+  /// the alignment; leaves it as it is with --align none.
+  MapAlignment alignEstimate(const std::optional<ImageSequence>& sequence,
+                             const Polylines3& ground_truth, Polylines3* estimate) const;
+  void printEvaluation(const std::string& curves_path, const CurveMapEvaluation& e) const;
+  void writeJsonReport(const std::string& curves_path, const CurveMapEvaluation& e,
+                       const MapAlignment& alignment, const nlohmann::json& edge_coverage) const;
   nlohmann::json reportEdgeCoverage(const Polylines3& estimate, const Polylines3& ground_truth,
                                     const std::vector<DatasetFrame>& frames,
                                     const ImageSequence& sequence, double spacing) const;

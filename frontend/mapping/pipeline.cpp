@@ -414,6 +414,13 @@ struct Pipeline::Impl {
                               CurveSampleCounts* samples);
   SceneExtent currentExtent() const;
   void checkCurves(bool drop);
+  /// One global BA of every promoted curve; `interim`: a re-association round follows.
+  ScheduleReport globalBundleAdjust(bool interim, CurveSampleCounts* samples);
+  /// The global BA and the re-association rounds after it, into `result`; returns whether the
+  /// curves were checked since the last BA.
+  bool runGlobalRounds(PipelineResult* result);
+  /// The keyframes, curves and points in the unit of the poses given, and the run's sanity.
+  void collectResult(int promoted, PipelineResult* result) const;
 
   PipelineOptions options;
   ImageUndistorter undistorter;
@@ -1110,85 +1117,96 @@ PipelineResult Pipeline::finish() {
   impl.finished = true;
   PipelineResult result;
   result.pose_stages.push_back(impl.poseStage("incremental"));
-  const bool drop = impl.options.sanity.drop_implausible_curves;
   // Every curve that reached the global map: the curves the sanity checks judge.
   const int promoted =
       static_cast<int>(impl.map.exportCurves(CurveSelection::kPromoted).ids.size());
-  // A check right after another with no BA between would judge the same map against an extent
-  // rebuilt from fewer curves, and could drop more for nothing having moved.
-  bool checked_since_ba = false;
   // Global BA starts from the initial poses, not from those the frontend was given.
   for (Keyframe& keyframe : impl.keyframes) {
     if (keyframe.given_frontend_cam_from_world) {
       keyframe.cam_from_world = keyframe.initial_cam_from_world;
     }
   }
+  bool checked_since_ba = false;
   if (impl.options.run_global_ba && impl.keyframes.size() >= 2) {
-    const int rounds = impl.options.reassociation_rounds;
-    const int budget = impl.options.reassociation_interim_iterations;
-    // An interim BA (one a re-association round follows) runs on the budget; the last does not,
-    // and may weigh the edges with its own kernel width.
-    const auto globalBa = [&](bool interim) {
-      SchedulerOptions scheduler = impl.options.global_ba;
-      if (interim && budget > 0) {
-        scheduler.optimizer.max_iterations = std::min(scheduler.optimizer.max_iterations, budget);
-      }
-      CurveBundleAdjustmentOptions ba = impl.options.ba;
-      if (!interim && impl.options.last_global_ba_kernel_width > 0.0) {
-        ba.kernel_width = impl.options.last_global_ba_kernel_width;
-      }
-      ScheduleReport report = impl.bundleAdjust(CurveSelection::kPromoted, scheduler, ba,
-                                                /*refine_poses=*/true, &result.final_samples);
-      ++impl.global_bas;
-      return report;
-    };
-    if (drop) impl.checkCurves(true);
-    result.global_ba = globalBa(rounds > 0);
-    result.pose_stages.push_back(impl.poseStage("global_ba"));
-    for (int r = 0; r < rounds; ++r) {
-      // Before re-association, so that no runaway curve gains observations.
-      if (drop) impl.checkCurves(true);
-      checked_since_ba = drop;
-      ReassociationRound round;
-      impl.reassociate(&round);
-      // A round that adds nothing ends them; the BA before it was interim, so under a budget
-      // the round's own BA still runs to convergence.
-      const bool last = r + 1 == rounds || round.added_observations == 0;
-      if (round.added_observations == 0 && budget == 0) break;
-      checked_since_ba = false;
-      round.global_ba = globalBa(!last);
-      result.reassociation.push_back(std::move(round));
-      result.pose_stages.push_back(impl.poseStage("reassociation_" + std::to_string(r + 1)));
-      if (last) break;
-    }
+    checked_since_ba = impl.runGlobalRounds(&result);
   }
-  if (!checked_since_ba) impl.checkCurves(drop);
+  if (!checked_since_ba) impl.checkCurves(impl.options.sanity.drop_implausible_curves);
+  impl.collectResult(promoted, &result);
+  return result;
+}
+
+// An interim BA (one a re-association round follows) runs on the budget; the last does not, and
+// may weigh the edges with its own kernel width.
+ScheduleReport Pipeline::Impl::globalBundleAdjust(bool interim, CurveSampleCounts* samples) {
+  SchedulerOptions scheduler = options.global_ba;
+  const int budget = options.reassociation_interim_iterations;
+  if (interim && budget > 0) {
+    scheduler.optimizer.max_iterations = std::min(scheduler.optimizer.max_iterations, budget);
+  }
+  CurveBundleAdjustmentOptions ba = options.ba;
+  if (!interim && options.last_global_ba_kernel_width > 0.0) {
+    ba.kernel_width = options.last_global_ba_kernel_width;
+  }
+  ScheduleReport report =
+      bundleAdjust(CurveSelection::kPromoted, scheduler, ba, /*refine_poses=*/true, samples);
+  ++global_bas;
+  return report;
+}
+
+bool Pipeline::Impl::runGlobalRounds(PipelineResult* result) {
+  const int rounds = options.reassociation_rounds;
+  const bool drop = options.sanity.drop_implausible_curves;
+  // A check right after another with no BA between would judge the same map against an extent
+  // rebuilt from fewer curves, and could drop more for nothing having moved.
+  bool checked_since_ba = false;
+  if (drop) checkCurves(true);
+  result->global_ba = globalBundleAdjust(rounds > 0, &result->final_samples);
+  result->pose_stages.push_back(poseStage("global_ba"));
+  for (int r = 0; r < rounds; ++r) {
+    // Before re-association, so that no runaway curve gains observations.
+    if (drop) checkCurves(true);
+    checked_since_ba = drop;
+    ReassociationRound round;
+    reassociate(&round);
+    // A round that adds nothing ends them; the BA before it was interim, so under a budget the
+    // round's own BA still runs to convergence.
+    const bool last = r + 1 == rounds || round.added_observations == 0;
+    if (round.added_observations == 0 && options.reassociation_interim_iterations == 0) break;
+    checked_since_ba = false;
+    round.global_ba = globalBundleAdjust(!last, &result->final_samples);
+    result->reassociation.push_back(std::move(round));
+    result->pose_stages.push_back(poseStage("reassociation_" + std::to_string(r + 1)));
+    if (last) break;
+  }
+  return checked_since_ba;
+}
+
+void Pipeline::Impl::collectResult(int promoted, PipelineResult* result) const {
   // Back from the scene scale to the unit of the poses given.
-  const double unit = impl.unit();
-  result.scene_scale = impl.gate.sceneScale();
-  for (const Keyframe& keyframe : impl.keyframes) {
-    result.keyframe_timestamps.push_back(keyframe.timestamp);
-    result.keyframe_initial_cam_from_world.push_back(keyframe.given_cam_from_world);
+  const double pose_unit = unit();
+  result->scene_scale = gate.sceneScale();
+  for (const Keyframe& keyframe : keyframes) {
+    result->keyframe_timestamps.push_back(keyframe.timestamp);
+    result->keyframe_initial_cam_from_world.push_back(keyframe.given_cam_from_world);
   }
   // Not the last stage's: with frontend poses and no global BA, that is the frontend's.
-  result.keyframe_cam_from_world = impl.poseStage("result").keyframe_cam_from_world;
-  for (const PolyBezier& curve : impl.map.exportCurves(CurveSelection::kPromoted).curves) {
-    result.curves.push_back(scaledCurve(curve, unit));
+  result->keyframe_cam_from_world = poseStage("result").keyframe_cam_from_world;
+  for (const PolyBezier& curve : map.exportCurves(CurveSelection::kPromoted).curves) {
+    result->curves.push_back(scaledCurve(curve, pose_unit));
   }
-  result.curve_statistics = impl.curveStatisticsInPoseUnits();
-  if (impl.options.ba.points) result.points = impl.points;
-  result.frames = impl.frames;
+  result->curve_statistics = curveStatisticsInPoseUnits();
+  if (options.ba.points) result->points = points;
+  result->frames = frames;
 
-  RunSanity& sanity = result.sanity;
-  sanity.extent = impl.extent.scaled(unit);
+  RunSanity& sanity = result->sanity;
+  sanity.extent = extent.scaled(pose_unit);
   sanity.checked_curves = promoted;
-  sanity.implausible_curves = impl.implausible;
+  sanity.implausible_curves = implausible;
   sanity.pose_move =
-      largestPoseMove(result.keyframe_initial_cam_from_world, result.keyframe_cam_from_world);
-  sanity.verdicts = judgeRun(
-      static_cast<int>(impl.keyframes.size()), static_cast<int>(result.curves.size()), promoted,
-      static_cast<int>(impl.implausible.size()), sanity.pose_move, impl.options.sanity);
-  return result;
+      largestPoseMove(result->keyframe_initial_cam_from_world, result->keyframe_cam_from_world);
+  sanity.verdicts =
+      judgeRun(static_cast<int>(keyframes.size()), static_cast<int>(result->curves.size()),
+               promoted, static_cast<int>(implausible.size()), sanity.pose_move, options.sanity);
 }
 
 void Pipeline::setPoints(std::vector<Eigen::Vector3d> points_in_world) {

@@ -14,6 +14,13 @@
 
 namespace curvesfm {
 
+/// The estimate's alignment onto the ground truth, when one was asked for.
+struct MapAlignment {
+  std::optional<TrajectoryEvaluation> evaluation;  ///< Empty with --align none.
+  double frames_axis_length = 0.0;  ///< > 0: fitted to the camera frames, axes this long.
+  std::string ground_truth_source;  ///< The ground-truth trajectory's file.
+};
+
 /// `curvesfm eval-map`: curve-map precision, recall and F-score at thresholds tau
 /// (core/curve_map_evaluation.h) of a run's curves against ground-truth curves (any format of
 /// readCurveMap: Pavilion's curve graph, synthcurves, an OBJ). The estimate is carried into the
@@ -22,12 +29,6 @@ namespace curvesfm {
 /// TUM file; `--align none` takes the curves as they are. Prints a table per tau and writes every
 /// figure and option as JSON. With `--edge-coverage`, also how much of the ground truth the
 /// dataset's images show as edges (frontend/image/edge_coverage.h) and the recall on that part.
-/// The estimate's alignment onto the ground truth, when one was asked for.
-struct MapAlignment {
-  std::optional<TrajectoryEvaluation> evaluation;  ///< Empty with --align none.
-  double frames_axis_length = 0.0;  ///< > 0: fitted to the camera frames, axes this long.
-  std::string ground_truth_source;  ///< The ground-truth trajectory's file.
-};
 
 class EvalMapCommand {
  public:

@@ -969,8 +969,7 @@ RunInput RunCommand::loadInput() const {
   return input;
 }
 
-// The pipeline's result and what decided how it ran.
-struct RunOutcome {
+struct RunCommand::Outcome {
   std::unique_ptr<Pipeline> pipeline;  // The last pass's, for its camera and overlays.
   PipelineResult result;
   PipelineOptions options;  // As run: the start model may have tied the start per pose.
@@ -980,25 +979,19 @@ struct RunOutcome {
   double image_wait_seconds = 0.0;
 };
 
-// The refined trajectory against the ground truth, and how well the images agree with it.
-struct RunEvaluation {
+struct RunCommand::Evaluation {
   AteResult ate;
   std::vector<StageMotion> motions;
-  std::map<std::string, FactorTypeCost> fit;
+  std::map<std::string, FactorTypeCost> fit;  // The images' agreement: cost per observation.
 };
 
-// What the output folder received beyond the fixed files.
-struct WrittenOutputs {
+struct RunCommand::Written {
   CurveExport exported;
   int overlays = 0;
   int worst_curve_images = 0;
 };
 
 namespace {
-
-RunEvaluation evaluateRun(const PipelineResult& result, const ImageSequence& sequence) {
-  return {evaluateAte(result, sequence), stageMotions(result, sequence), finalFit(result)};
-}
 
 // The process's exit status: 1 when nothing plausible was reconstructed or a global BA failed,
 // each with one line on stderr after the summary.
@@ -1047,9 +1040,10 @@ int RunCommand::run() const {
   std::printf("run: %s (%s layout), %zu of %zu images with an initial pose (%s), camera %dx%d\n",
               dataset_dir_.c_str(), d.layout.c_str(), input.frames.size(), d.images.size(),
               input.init_poses_source.c_str(), d.camera.width(), d.camera.height());
-  const RunOutcome outcome = refine(input);
-  const RunEvaluation evaluation = evaluateRun(outcome.result, d);
-  const WrittenOutputs written = writeOutputs(input, outcome);
+  const Outcome outcome = refine(input);
+  const Evaluation evaluation{evaluateAte(outcome.result, d), stageMotions(outcome.result, d),
+                              finalFit(outcome.result)};
+  const Written written = writeOutputs(input, outcome);
   const double seconds = secondsSince(start);
   writeJsonFile(joinPath(out_dir_, "report.json"),
                 reportJson(input, outcome, evaluation, written, seconds));
@@ -1059,8 +1053,8 @@ int RunCommand::run() const {
 
 // Reads how the start is to be held, then runs the pipeline once, and once more per relift pass
 // at the previous pass's refined poses.
-RunOutcome RunCommand::refine(const RunInput& input) const {
-  RunOutcome outcome;
+RunCommand::Outcome RunCommand::refine(const RunInput& input) const {
+  Outcome outcome;
   outcome.options = options_;
   outcome.start_model = readStartModel(input, start_model_, &outcome.options);
   outcome.options.global_ba.optimizer.on_iteration = globalBaProgress(progress_interval_s_);
@@ -1083,7 +1077,7 @@ RunOutcome RunCommand::refine(const RunInput& input) const {
 
 // Trajectories, points, curves with their statistics, config.yaml and, with --overlays, the
 // overlays and the worst curves.
-WrittenOutputs RunCommand::writeOutputs(const RunInput& input, const RunOutcome& outcome) const {
+RunCommand::Written RunCommand::writeOutputs(const RunInput& input, const Outcome& outcome) const {
   const PipelineResult& result = outcome.result;
   writeTrajectory(joinPath(out_dir_, "trajectory.txt"),
                   stampedPoses(result.keyframe_timestamps, result.keyframe_cam_from_world));
@@ -1094,7 +1088,7 @@ WrittenOutputs RunCommand::writeOutputs(const RunInput& input, const RunOutcome&
     writeInitialisedPoints(joinPath(out_dir_, "points.ply"), *input.initialisation,
                            result.points.empty() ? nullptr : &result.points);
   }
-  WrittenOutputs written;
+  Written written;
   written.exported =
       selectExportedCurves(result.curves, result.curve_statistics, export_min_epipolar_angle_deg_);
   const CurveExport& exported = written.exported;
@@ -1114,9 +1108,9 @@ WrittenOutputs RunCommand::writeOutputs(const RunInput& input, const RunOutcome&
   return written;
 }
 
-nlohmann::json RunCommand::reportJson(const RunInput& input, const RunOutcome& outcome,
-                                      const RunEvaluation& evaluation,
-                                      const WrittenOutputs& written, double seconds) const {
+nlohmann::json RunCommand::reportJson(const RunInput& input, const Outcome& outcome,
+                                      const Evaluation& evaluation, const Written& written,
+                                      double seconds) const {
   const ImageSequence& d = input.sequence;
   const PipelineResult& result = outcome.result;
   nlohmann::json frames = nlohmann::json::array();
@@ -1170,8 +1164,8 @@ nlohmann::json RunCommand::reportJson(const RunInput& input, const RunOutcome& o
       {"peak_memory_mib", peakResidentMiB()}};
 }
 
-void RunCommand::printResults(const RunInput& input, const RunOutcome& outcome,
-                              const RunEvaluation& evaluation, const WrittenOutputs& written,
+void RunCommand::printResults(const RunInput& input, const Outcome& outcome,
+                              const Evaluation& evaluation, const Written& written,
                               double seconds) const {
   const PipelineResult& result = outcome.result;
   printSummary(input, result, seconds, images_ahead_ ? outcome.image_wait_seconds : -1.0);

@@ -14,9 +14,6 @@
 namespace curvesfm {
 
 struct RunInput;
-struct RunOutcome;
-struct RunEvaluation;
-struct WrittenOutputs;
 
 /// `curvesfm run`: the incremental curve SfM pipeline on a dataset in any layout of
 /// loadImageSequence (README "Dataset layouts"): takes the initial poses from --init-poses (a TUM
@@ -42,21 +39,24 @@ class RunCommand {
   int run() const;
 
  private:
+  struct Outcome;     ///< The pipeline's result and what decided how it ran.
+  struct Evaluation;  ///< The result against the ground truth and the images.
+  struct Written;     ///< What the output folder received beyond the fixed files.
+
   /// The images with their initial poses: read, or found by the point initialiser.
   RunInput loadInput() const;
   std::vector<Pose3> frontendPoses(const RunInput& input) const;
   /// Every option in force, for report.json: the table's and the run's own.
   nlohmann::json runOptionsJson() const;
   /// The pipeline over the input, once more per relift pass.
-  RunOutcome refine(const RunInput& input) const;
-  WrittenOutputs writeOutputs(const RunInput& input, const RunOutcome& outcome) const;
-  nlohmann::json reportJson(const RunInput& input, const RunOutcome& outcome,
-                            const RunEvaluation& evaluation, const WrittenOutputs& written,
+  Outcome refine(const RunInput& input) const;
+  Written writeOutputs(const RunInput& input, const Outcome& outcome) const;
+  nlohmann::json reportJson(const RunInput& input, const Outcome& outcome,
+                            const Evaluation& evaluation, const Written& written,
                             double seconds) const;
   /// The summary lines after the run.
-  void printResults(const RunInput& input, const RunOutcome& outcome,
-                    const RunEvaluation& evaluation, const WrittenOutputs& written,
-                    double seconds) const;
+  void printResults(const RunInput& input, const Outcome& outcome, const Evaluation& evaluation,
+                    const Written& written, double seconds) const;
 
   CLI::App* command_;
   std::string dataset_dir_;

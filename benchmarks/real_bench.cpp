@@ -1055,6 +1055,128 @@ std::vector<RealSet> selectedSets(const BenchOptions& options, const fs::path& o
   return sets;
 }
 
+// The frames a set is read with: its table row's camera, stride and cap, or the command's.
+ImageSequenceOptions sequenceOptionsFor(const RealSet& set, const BenchOptions& options) {
+  ImageSequenceOptions sequence_options;
+  sequence_options.camera = set.camera;
+  sequence_options.stride = options.stride > 0 ? options.stride : set.stride;
+  sequence_options.max_frames = set.max_frames;
+  if (options.max_frames > 0 && (set.max_frames == 0 || options.max_frames < set.max_frames)) {
+    sequence_options.max_frames = options.max_frames;
+  }
+  return sequence_options;
+}
+
+// What makes a set's rows differ from its table entry: the table's own note, then the caps.
+std::string setNote(const RealSet& set, const BenchOptions& options,
+                    const ImageSequenceOptions& sequence_options) {
+  std::string note = set.why;
+  if (options.stride > 0 && options.stride != set.stride) {
+    note += std::string(note.empty() ? "" : "; ") + "--stride " + std::to_string(options.stride) +
+            " overrides the table's stride " + std::to_string(set.stride);
+  }
+  if (sequence_options.max_frames > 0) {
+    note += std::string(note.empty() ? "" : "; ") + "first " +
+            std::to_string(sequence_options.max_frames) + " frames";
+  }
+  return note;
+}
+
+// One set's images and ground truth (written beside its rows), or nullopt with a `# skipped`
+// line when it cannot be read or has no ground truth.
+std::optional<ImageSequence> loadSet(const RealSet& set, const BenchOptions& options,
+                                     const ImageSequenceOptions& sequence_options,
+                                     const fs::path& set_dir) {
+  try {
+    ImageSequence sequence =
+        loadImageSequence((fs::path(options.data) / set.subdir).string(), sequence_options);
+    if (sequence.ground_truth.empty()) throw Error("no ground truth");
+    writeTrajectory((set_dir / "groundtruth.txt").string(), sequence.ground_truth);
+    return sequence;
+  } catch (const Error& e) {
+    std::printf("# skipped %s: %s\n", set.name.c_str(), e.what());
+    return std::nullopt;
+  }
+}
+
+// Everything one row of the bench needs besides its variant and start.
+struct SetRun {
+  const BenchOptions& options;
+  const RealSet& set;
+  const ImageSequence& sequence;
+  const ImageSequenceOptions& sequence_options;
+  const fs::path& set_dir;
+  const std::string& note;
+  const std::string& colmap;  // Empty when not on PATH.
+  FlagCatalogue* catalogue;
+  std::vector<StampedPose>* colmap_poses;  // Filled by the COLMAP row, read by its start.
+};
+
+// Runs one variant from one start into its own folder and returns its row.
+Row runRow(const SetRun& run, const Variant& variant, const Start& start, int number, int total) {
+  Row row;
+  row.set = run.set.name;
+  row.variant = variant.name;
+  if (variant.command == "run") row.start = start.label();
+  row.frames = static_cast<int>(run.sequence.images.size());
+  const fs::path dir =
+      run.set_dir / (start.kind == "init" ? variant.name : variant.name + "_" + start.label());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::printf("[%d/%d] %s %s%s: running\n", number, total, run.set.name.c_str(),
+              variant.name.c_str(), row.start.empty() ? "" : (" from " + row.start).c_str());
+  std::fflush(stdout);
+  Variant run_variant = variant;  // with --map-at's flag once its poses file exists
+  try {
+    if (variant.name == "colmap") {
+      if (run.colmap.empty()) {
+        row.status = "skipped";
+        row.note = "colmap is not on PATH";
+      } else {
+        runColmap(run.options, run.colmap, run.sequence, dir, &row, run.colmap_poses);
+      }
+    } else {
+      const std::string init_poses =
+          startPosesFile(start, run.sequence, *run.colmap_poses, run.options, run.set_dir);
+      run_variant = withStartPrior(withMapAt(variant, run.sequence, run.options, run.set_dir),
+                                   start, run.options);
+      runCurvesfm(run.options, run_variant, run.set, run.sequence, run.sequence_options, init_poses,
+                  run.catalogue, dir, &row);
+    }
+  } catch (const Error& e) {
+    row.status = "failed";
+    row.note = e.what();
+  }
+  if (row.status == "ok") {
+    // The caps and flags that make this row differ from a plain run, then the run's note.
+    std::vector<std::string> parts;
+    for (const std::string& part : {run.note, joinWords(run_variant.flags), row.note}) {
+      if (!part.empty()) parts.push_back(part);
+    }
+    row.note = joinWords(parts, "; ");
+  }
+  return row;
+}
+
+// real_bench.md, then the table and the summaries on stdout, and the figures.
+void reportRows(const std::vector<Row>& rows, const BenchOptions& options,
+                const std::string& command, const fs::path& out) {
+  const std::string table = markdownTable(rows, options.tracking_threads);
+  {
+    std::ofstream md(out / "real_bench.md");
+    md << "# Real sets: initialiser, curves, hybrid BA, COLMAP\n\nCommand: `" << command
+       << "`\n\nATE and RPE: Sim(3)-aligned, in the ground truth's unit (m; Blender units for "
+          "pavilion); init and COLMAP evaluate every registered frame, curves and hybrid the "
+          "keyframes of the curve pipeline. Times are wall times in seconds.\n\n"
+       << table;
+    if (!md) throw IoError((out / "real_bench.md").string(), "cannot write");
+  }
+  std::printf("\n%s\n", table.c_str());
+  printSummary(rows, options.variants);
+  printStartSummary(rows);
+  printFitSummary(rows);
+}
+
 int run(const BenchOptions& options, const std::string& command) {
   const Clock::time_point start = Clock::now();
   checkMapAt(options);
@@ -1083,101 +1205,26 @@ int run(const BenchOptions& options, const std::string& command) {
   }
   const int total = static_cast<int>(sets.size()) * rows_per_set;
   for (const RealSet& set : sets) {
-    ImageSequenceOptions sequence_options;
-    sequence_options.camera = set.camera;
-    sequence_options.stride = options.stride > 0 ? options.stride : set.stride;
-    sequence_options.max_frames = set.max_frames;
-    if (options.max_frames > 0 && (set.max_frames == 0 || options.max_frames < set.max_frames)) {
-      sequence_options.max_frames = options.max_frames;
-    }
+    const ImageSequenceOptions sequence_options = sequenceOptionsFor(set, options);
     const fs::path set_dir = out / set.name;
     fs::create_directories(set_dir);
-    std::string set_note = set.why;
-    if (options.stride > 0 && options.stride != set.stride) {
-      set_note += std::string(set_note.empty() ? "" : "; ") + "--stride " +
-                  std::to_string(options.stride) + " overrides the table's stride " +
-                  std::to_string(set.stride);
-    }
-    if (sequence_options.max_frames > 0) {
-      set_note += std::string(set_note.empty() ? "" : "; ") + "first " +
-                  std::to_string(sequence_options.max_frames) + " frames";
-    }
-    ImageSequence sequence;
-    try {
-      sequence =
-          loadImageSequence((fs::path(options.data) / set.subdir).string(), sequence_options);
-      if (sequence.ground_truth.empty()) throw Error("no ground truth");
-      writeTrajectory((set_dir / "groundtruth.txt").string(), sequence.ground_truth);
-    } catch (const Error& e) {
-      std::printf("# skipped %s: %s\n", set.name.c_str(), e.what());
-      continue;
-    }
+    const std::string note = setNote(set, options, sequence_options);
+    const std::optional<ImageSequence> sequence = loadSet(set, options, sequence_options, set_dir);
+    if (!sequence) continue;
     std::vector<StampedPose> colmap_poses;
+    const SetRun set_run{options, set,    *sequence,  sequence_options, set_dir,
+                         note,    colmap, &catalogue, &colmap_poses};
     for (const Variant& variant : variants) {
       for (const Start& start : startsOf(variant, options)) {
-        Row row;
-        row.set = set.name;
-        row.variant = variant.name;
-        if (variant.command == "run") row.start = start.label();
-        row.frames = static_cast<int>(sequence.images.size());
-        const fs::path dir =
-            set_dir / (start.kind == "init" ? variant.name : variant.name + "_" + start.label());
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-        std::printf("[%zu/%d] %s %s%s: running\n", rows.size() + 1, total, set.name.c_str(),
-                    variant.name.c_str(), row.start.empty() ? "" : (" from " + row.start).c_str());
-        std::fflush(stdout);
-        Variant run_variant = variant;  // with --map-at's flag once its poses file exists
-        try {
-          if (variant.name == "colmap") {
-            if (colmap.empty()) {
-              row.status = "skipped";
-              row.note = "colmap is not on PATH";
-            } else {
-              runColmap(options, colmap, sequence, dir, &row, &colmap_poses);
-            }
-          } else {
-            const std::string init_poses =
-                startPosesFile(start, sequence, colmap_poses, options, set_dir);
-            run_variant =
-                withStartPrior(withMapAt(variant, sequence, options, set_dir), start, options);
-            runCurvesfm(options, run_variant, set, sequence, sequence_options, init_poses,
-                        &catalogue, dir, &row);
-          }
-        } catch (const Error& e) {
-          row.status = "failed";
-          row.note = e.what();
-        }
-        if (row.status == "ok") {
-          // The caps and flags that make this row differ from a plain run, then the run's note.
-          std::vector<std::string> parts;
-          for (const std::string& part : {set_note, joinWords(run_variant.flags), row.note}) {
-            if (!part.empty()) parts.push_back(part);
-          }
-          row.note = joinWords(parts, "; ");
-        }
-        rows.push_back(row);
-        printProgress(row, static_cast<int>(rows.size()), total);
+        rows.push_back(runRow(set_run, variant, start, static_cast<int>(rows.size()) + 1, total));
+        printProgress(rows.back(), static_cast<int>(rows.size()), total);
         // Rewritten after every row, so that a long bench stopped half-way keeps what it
         // measured.
         writeCsv(rows, out / "real_bench.csv");
       }
     }
   }
-  const std::string table = markdownTable(rows, options.tracking_threads);
-  {
-    std::ofstream md(out / "real_bench.md");
-    md << "# Real sets: initialiser, curves, hybrid BA, COLMAP\n\nCommand: `" << command
-       << "`\n\nATE and RPE: Sim(3)-aligned, in the ground truth's unit (m; Blender units for "
-          "pavilion); init and COLMAP evaluate every registered frame, curves and hybrid the "
-          "keyframes of the curve pipeline. Times are wall times in seconds.\n\n"
-       << table;
-    if (!md) throw IoError((out / "real_bench.md").string(), "cannot write");
-  }
-  std::printf("\n%s\n", table.c_str());
-  printSummary(rows, options.variants);
-  printStartSummary(rows);
-  printFitSummary(rows);
+  reportRows(rows, options, command, out);
   bench::print("total_seconds", bench::secondsSince(start));
   bench::printText("outputs", (out / "{real_bench.csv,real_bench.md}").string());
   drawFiguresIfPossible({"real-bench", out.string()});

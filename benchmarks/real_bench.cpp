@@ -1158,7 +1158,7 @@ Row runRow(const SetRun& run, const Variant& variant, const Start& start, int nu
   return row;
 }
 
-// real_bench.md, then the table and the summaries on stdout, and the figures.
+// real_bench.md, then the table and the summaries on stdout.
 void reportRows(const std::vector<Row>& rows, const BenchOptions& options,
                 const std::string& command, const fs::path& out) {
   const std::string table = markdownTable(rows, options.tracking_threads);

@@ -617,8 +617,8 @@ void printSummary(const RunInput& input, const PipelineResult& r, double seconds
       frontend, local_ba, r.globalBaSeconds(), seconds, peakResidentMiB());
   if (image_wait_seconds >= 0.0) {
     std::printf(
-        "images ahead: the image stage (%.2f s of the frontend) ran on a second thread while "
-        "local BA did; %.2f s waited for it\n",
+        "images ahead: the image stage (%.2f s of the frontend) ran on a second thread, each "
+        "keyframe's beside the previous keyframe's work; %.2f s waited for it\n",
         image_stage, image_wait_seconds);
   }
   printFrontendStages(r.frames);
@@ -845,7 +845,8 @@ RunCommand::RunCommand(CLI::App* app) {
       ->capture_default_str();
   c->add_option("--images-ahead", images_ahead_,
                 "Load and prepare the next keyframe's image (undistortion, edges, field) on a "
-                "second thread while this one's local BA runs; the results are the same")
+                "second thread while this one's depth search, correspondence and local BA run; the "
+                "results are the same")
       ->capture_default_str();
   c->add_option("--diagnose-frontend-poses", frontend_poses_path_,
                 "Diagnosis: lift and register curves at these poses (TUM or COLMAP model, in the "

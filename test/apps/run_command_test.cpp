@@ -195,7 +195,7 @@ TEST_F(RunCommandTest, OverlaysColourTheCurvesAndDrawTheWorstOnesUnderTheirDocum
   const nlohmann::json report = readReport(out);
   EXPECT_EQ(report["options"]["overlay"]["colour_by"], "track");
   EXPECT_TRUE(std::filesystem::exists(out + "/overlays/000005.png"));
-  // Each worst curve drawn on its worst keyframe, under the name the README gives, and indexed.
+  // Each worst curve drawn on its worst keyframe, under the name docs/run.md gives, and indexed.
   const nlohmann::json& statistics = report["curve_statistics"];
   ASSERT_FALSE(statistics["highest_residual"].empty());
   std::ifstream index_file(out + "/worst_curves/worst_curves.md");

@@ -29,7 +29,7 @@ TEST(PlanarBenchCommandLine, RejectsAnEmptyItem) {
 }
 
 TEST(PlanarBenchCommandLine, RejectsANoiseLevelThatIsNoPercentage) {
-  for (const std::string& level : {"abc", "101", "-5", "5x"}) {
+  for (const std::string level : {"abc", "101", "-5", "5x"}) {
     const testing::CommandResult r = runPlanarBench("--noise 0," + level);
     EXPECT_EQ(r.exit_code, 2) << level << ": " << r.output;
     EXPECT_THAT(r.output, HasSubstr("--noise: '" + level + "' is not a percentage in [0, 100]"));

@@ -15,8 +15,10 @@ constexpr Eigen::Index kBlock = 128;
 // Strips of the trailing update: narrow enough that the triangle above the diagonal each
 // computes for nothing stays small, wide enough for GEMM.
 constexpr Eigen::Index kUpdateWidth = 64;
-// A step goes to the threads only when its trailing update is large enough to pay for starting
-// them (about 0.1 ms a step): at n = 600 two threads took 2.3 ms against 1.5 ms on one.
+// A step goes to the threads only when its trailing update is large enough to pay for handing
+// it over: when each call started its threads, two took 2.3 ms at n = 600 against 1.5 ms on one;
+// with the kept threads of core/parallel.h a bound of 256 or 128 still gains nothing at n = 600
+// or 900 (1.6 and 4.3-4.9 ms on either), while 1,200 takes 9.4 ms on two against 12.5 on one.
 constexpr Eigen::Index kMinParallelRest = 512;
 
 // Column splits of an n x n lower triangle into runs of about equal area, one per thread,

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <functional>
@@ -36,6 +37,71 @@ TEST(RunInParallel, RethrowsAWorkersExceptionOnTheCallingThread) {
   EXPECT_EQ(finished.load(), 1);
 }
 
+// Spins until `done` or 10 s have passed, so that a broken promise fails a check instead of
+// hanging the suite.
+bool waitUpTo10s(const std::function<bool()>& done) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::yield();
+  }
+  return true;
+}
+
+// Every work(t) waits for all the others to start: only threads that run at once get through.
+void expectRunsAtOnce(int num_threads) {
+  std::atomic<int> started{0};
+  std::atomic<int> timed_out{0};
+  runInParallel(num_threads, [&](int) {
+    ++started;
+    if (!waitUpTo10s([&] { return started.load() == num_threads; })) ++timed_out;
+  });
+  EXPECT_EQ(timed_out.load(), 0) << num_threads << " threads did not all run at once";
+}
+
+TEST(RunInParallel, RunsAllThreadsAtOnce) {
+  expectRunsAtOnce(2);
+  expectRunsAtOnce(5);
+}
+
+// The threads are kept between calls: work(1), held until the caller's work(0) has seen it start
+// (so that the caller cannot take it over), runs on a thread that ran it in an earlier call.
+TEST(RunInParallel, KeepsItsThreadsBetweenCalls) {
+  thread_local int runs_on_this_thread = 0;
+  int most_runs_on_one_thread = 0;
+  for (int call = 0; call < 20; ++call) {
+    std::atomic<bool> second_started{false};
+    runInParallel(2, [&](int t) {
+      if (t == 0) {
+        EXPECT_TRUE(waitUpTo10s([&] { return second_started.load(); }));
+        return;
+      }
+      most_runs_on_one_thread = std::max(most_runs_on_one_thread, ++runs_on_this_thread);
+      second_started = true;
+    });
+  }
+  EXPECT_GT(most_runs_on_one_thread, 1) << "a new thread for every call";
+}
+
+// Callers on several threads at once, and work that itself runs work in parallel: every work(t)
+// once, each caller's threads at once.
+TEST(RunInParallel, ServesConcurrentAndNestedCallers) {
+  constexpr int kCallers = 4;
+  constexpr int kCalls = 50;
+  std::vector<std::atomic<int>> runs(kCallers);
+  std::vector<std::thread> callers;
+  for (int c = 0; c < kCallers; ++c) {
+    callers.emplace_back([&, c] {
+      for (int call = 0; call < kCalls; ++call) {
+        runInParallel(3, [&](int) { runInParallel(2, [&](int) { ++runs[c]; }); });
+      }
+      expectRunsAtOnce(3);
+    });
+  }
+  for (std::thread& caller : callers) caller.join();
+  for (const std::atomic<int>& count : runs) EXPECT_EQ(count.load(), kCalls * 3 * 2);
+}
+
 TEST(ForEachInParallel, RunsEveryItemOnceOnNoMoreThreadsThanBlocks) {
   std::vector<std::atomic<int>> runs(103);
   std::vector<std::atomic<int>> by_thread(8);
@@ -54,22 +120,18 @@ TEST(ForEachInParallel, RunsEveryItemOnceOnNoMoreThreadsThanBlocks) {
   forEachInParallel(4, 0, 10, [](int, int) { FAIL() << "no item to run"; });
 }
 
-// A thread that is held up takes fewer blocks: the others go on with the rest. The waits give up
-// after 10 s, so that a fixed split fails the checks instead of hanging.
+// A thread that is held up takes fewer blocks: the others go on with the rest (a fixed split
+// fails the checks).
 TEST(ForEachInParallel, AThreadHeldUpTakesFewerBlocks) {
   std::vector<std::atomic<int>> by_thread(2);
   std::atomic<bool> released{false};
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-  const auto wait_until = [&](const std::function<bool()>& done) {
-    while (!done() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
-  };
   forEachInParallel(2, 100, 1, [&](int t, int) {
     if (t == 0) {  // Held until the other thread has run every other item.
       ++by_thread[0];
-      wait_until([&] { return released.load(); });
+      waitUpTo10s([&] { return released.load(); });
       return;
     }
-    wait_until([&] { return by_thread[0].load() > 0; });
+    waitUpTo10s([&] { return by_thread[0].load() > 0; });
     if (++by_thread[1] == 99) released = true;
   });
   EXPECT_EQ(by_thread[0].load(), 1);

@@ -1,5 +1,6 @@
 #include "core/parallel.h"
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -31,23 +32,16 @@ struct Job {
   std::condition_variable all_finished;
 };
 
-// Threads that wait for jobs and are never ended before the process. Invariant (under mutex_):
-// idle_ >= unclaimed_, so every posted work(t) has a thread free to start it at once; that keeps
+// Threads that wait for jobs until the process ends. Invariant (under mutex_): idle_ >=
+// unclaimed_, so every posted work(t) has a thread free to start it at once; that keeps
 // runInParallel's promise that the work(t) run concurrently (a caller may wait on another t).
 class WorkerPool {
  public:
+  // Never destroyed: joining the threads at exit would hang or abort when exit() is called while
+  // a work(t) runs, or from one.
   static WorkerPool& shared() {
-    static WorkerPool pool;
-    return pool;
-  }
-
-  ~WorkerPool() {
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      stopping_ = true;
-    }
-    wake_.notify_all();
-    for (std::thread& thread : threads_) thread.join();
+    static WorkerPool* const pool = new WorkerPool;
+    return *pool;
   }
 
   void run(int count, const std::function<void(int)>& work) {
@@ -78,7 +72,7 @@ class WorkerPool {
       const std::lock_guard<std::mutex> lock(mutex_);
       pending_.push_back(job);
       unclaimed_ += helpers;
-      for (; idle_ < unclaimed_; ++idle_) threads_.emplace_back([this] { serve(); });
+      for (; idle_ < unclaimed_; ++idle_) std::thread([this] { serve(); }).detach();
     }
     if (helpers == 1) {
       wake_.notify_one();
@@ -95,11 +89,10 @@ class WorkerPool {
     return t;
   }
 
-  void serve() {
+  [[noreturn]] void serve() {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
-      wake_.wait(lock, [&] { return stopping_ || !pending_.empty(); });
-      if (pending_.empty()) return;
+      wake_.wait(lock, [&] { return !pending_.empty(); });
       Job* job = pending_.front();
       const int t = claim(job);
       --idle_;
@@ -115,10 +108,8 @@ class WorkerPool {
   std::mutex mutex_;
   std::condition_variable wake_;
   std::deque<Job*> pending_;  // Jobs with a work(t) nobody has claimed.
-  std::vector<std::thread> threads_;
-  int idle_ = 0;       // Threads not running a work(t).
-  int unclaimed_ = 0;  // Posted work(t) not claimed yet.
-  bool stopping_ = false;
+  int idle_ = 0;              // Threads not running a work(t).
+  int unclaimed_ = 0;         // Posted work(t) not claimed yet.
 };
 
 }  // namespace

@@ -23,7 +23,7 @@ double totalCost(const std::map<std::string, FactorTypeCost>& by_type);
 /// cheap to copy and a solver may hold them while the graph changes.
 class FactorGraph {
  public:
-  /// Below this many factors a thread of costByType costs more to start than it saves.
+  /// Below this many factors a thread of costByType costs more to hand the work to than it saves.
   static constexpr int kMinFactorsPerThread = 256;
 
   using FactorPtr = std::shared_ptr<const Factor>;

@@ -758,7 +758,7 @@ std::vector<ReferenceCandidate> rankReferenceFrames(
 namespace {
 
 // No run under this many chain pixels (a search takes about 2 us a pixel): a small keyframe then
-// starts fewer threads, each tens of us to start, than its few pixels would repay.
+// hands its few pixels to fewer threads, each a few microseconds to wake (core/parallel.h).
 constexpr std::size_t kMinPixelsPerRun = 256;
 
 // Where each of up to `runs` runs of consecutive chains starts, with about as many pixels each,

@@ -1,6 +1,9 @@
 #include "core/parallel.h"
 
+#include <pthread.h>
+
 #include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -37,13 +40,6 @@ struct Job {
 // runInParallel's promise that the work(t) run concurrently (a caller may wait on another t).
 class WorkerPool {
  public:
-  // Never destroyed: joining the threads at exit would hang or abort when exit() is called while
-  // a work(t) runs, or from one.
-  static WorkerPool& shared() {
-    static WorkerPool* const pool = new WorkerPool;
-    return *pool;
-  }
-
   void run(int count, const std::function<void(int)>& work) {
     Job job(work, count);
     post(&job);
@@ -112,6 +108,24 @@ class WorkerPool {
   int unclaimed_ = 0;         // Posted work(t) not claimed yet.
 };
 
+// The process's pool, made at the first parallel call. Never destroyed: joining its threads at
+// exit would hang or abort when exit() is called while a work(t) runs, or from one. A child of
+// fork() has none of its parent's threads (and perhaps a mutex one of them held), so it leaves
+// the parent's pool and makes its own when it first needs one.
+std::atomic<WorkerPool*> shared_pool{nullptr};
+
+WorkerPool& sharedPool() {
+  static const int fork_handler =
+      pthread_atfork(nullptr, nullptr, [] { shared_pool.store(nullptr); });
+  (void)fork_handler;
+  WorkerPool* pool = shared_pool.load();
+  if (pool != nullptr) return *pool;
+  auto* made = new WorkerPool;
+  if (shared_pool.compare_exchange_strong(pool, made)) return *made;
+  delete made;  // Another thread's came first; `pool` is now that one.
+  return *pool;
+}
+
 }  // namespace
 
 void runInParallel(int num_threads, const std::function<void(int thread)>& work) {
@@ -119,7 +133,7 @@ void runInParallel(int num_threads, const std::function<void(int thread)>& work)
     work(0);
     return;
   }
-  WorkerPool::shared().run(num_threads, work);
+  sharedPool().run(num_threads, work);
 }
 
 }  // namespace curvesfm

@@ -1,6 +1,8 @@
 #include "core/parallel.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -100,6 +102,27 @@ TEST(RunInParallel, ServesConcurrentAndNestedCallers) {
   }
   for (std::thread& caller : callers) caller.join();
   for (const std::atomic<int>& count : runs) EXPECT_EQ(count.load(), kCalls * 3 * 2);
+}
+
+// A child of fork() has none of its parent's threads: its calls still get a thread per work(t)
+// at once (the benchmarks run their configurations in forked children).
+TEST(RunInParallel, RunsAllThreadsAtOnceInAForkedChild) {
+  expectRunsAtOnce(3);  // The parent's threads exist from here on.
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::atomic<int> started{0};
+    std::atomic<int> timed_out{0};
+    runInParallel(3, [&](int) {
+      ++started;
+      if (!waitUpTo10s([&] { return started.load() == 3; })) ++timed_out;
+    });
+    _exit(timed_out.load() == 0 ? 0 : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "the child's threads did not all run at once";
 }
 
 TEST(ForEachInParallel, RunsEveryItemOnceOnNoMoreThreadsThanBlocks) {

@@ -8,6 +8,7 @@
 #include <deque>
 #include <exception>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -68,7 +69,11 @@ class WorkerPool {
       const std::lock_guard<std::mutex> lock(mutex_);
       pending_.push_back(job);
       unclaimed_ += helpers;
-      for (; idle_ < unclaimed_; ++idle_) std::thread([this] { serve(); }).detach();
+      try {
+        for (; idle_ < unclaimed_; ++idle_) std::thread([this] { serve(); }).detach();
+      } catch (const std::system_error&) {
+        // No thread to be had (a process limit): the callers run what no worker claims.
+      }
     }
     if (helpers == 1) {
       wake_.notify_one();

@@ -8,14 +8,15 @@ namespace curvesfm {
 
 /// Runs work(0) .. work(num_threads - 1) at once, work(0) on the calling thread, and returns
 /// when all are done. The others run on a process-wide pool of worker threads, started when
-/// first needed and kept for later calls: on the machines we measured, starting and ending a
-/// thread per call cost 50 us, and up to 190 us when its stack had to be paged in again, at
-/// thousands of calls a run (each LM iteration, each keyframe's registration). The pool grows
-/// so that every work(t) gets a thread of its own at once, also when several callers (or a
-/// work(t) itself) call this concurrently; the calling thread takes a work(t) no worker has
-/// started yet once it is done with work(0). An exception thrown by any work(t) is rethrown
-/// here, the lowest t's, once all have ended: on a thread of its own it would end the process
-/// instead of reaching the caller's error message.
+/// first needed and kept for later calls: on the machine we measured, starting and ending a
+/// thread per call cost 50 us, up to 190 us when its stack had to be paged in again, and with
+/// both cores busy a new thread began 3.9 ms late (a kept one 3.3 us), at thousands of calls a
+/// run (each LM iteration, each keyframe's registration). The pool grows so that every work(t)
+/// gets a thread of its own at once, also when several callers (or a work(t) itself) call this
+/// concurrently, unless the process may start no more threads; the calling thread takes a
+/// work(t) no worker has started yet once it is done with work(0). An exception thrown by any
+/// work(t) is rethrown here, the lowest t's, once all have ended: on a thread of its own it would
+/// end the process instead of reaching the caller's error message.
 void runInParallel(int num_threads, const std::function<void(int thread)>& work);
 
 /// Runs work(thread, i) for every i in [0, count) on up to num_threads threads (thread 0 the

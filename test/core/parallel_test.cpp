@@ -50,15 +50,20 @@ bool waitUpTo10s(const std::function<bool()>& done) {
   return true;
 }
 
-// Every work(t) waits for all the others to start: only threads that run at once get through.
-void expectRunsAtOnce(int num_threads) {
+// Whether num_threads work(t) ran at once: each waits for all the others to start, and only
+// threads that run at once get through.
+bool runsAtOnce(int num_threads) {
   std::atomic<int> started{0};
   std::atomic<int> timed_out{0};
   runInParallel(num_threads, [&](int) {
     ++started;
     if (!waitUpTo10s([&] { return started.load() == num_threads; })) ++timed_out;
   });
-  EXPECT_EQ(timed_out.load(), 0) << num_threads << " threads did not all run at once";
+  return timed_out.load() == 0;
+}
+
+void expectRunsAtOnce(int num_threads) {
+  EXPECT_TRUE(runsAtOnce(num_threads)) << num_threads << " threads did not all run at once";
 }
 
 TEST(RunInParallel, RunsAllThreadsAtOnce) {
@@ -110,15 +115,7 @@ TEST(RunInParallel, RunsAllThreadsAtOnceInAForkedChild) {
   expectRunsAtOnce(3);  // The parent's threads exist from here on.
   const pid_t child = fork();
   ASSERT_GE(child, 0);
-  if (child == 0) {
-    std::atomic<int> started{0};
-    std::atomic<int> timed_out{0};
-    runInParallel(3, [&](int) {
-      ++started;
-      if (!waitUpTo10s([&] { return started.load() == 3; })) ++timed_out;
-    });
-    _exit(timed_out.load() == 0 ? 0 : 1);
-  }
+  if (child == 0) _exit(runsAtOnce(3) ? 0 : 1);
   int status = 0;
   ASSERT_EQ(waitpid(child, &status, 0), child);
   ASSERT_TRUE(WIFEXITED(status));

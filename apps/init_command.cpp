@@ -10,6 +10,7 @@
 #include "apps/cli/report_json.h"
 #include "core/clock.h"
 #include "core/errors.h"
+#include "core/heap_policy.h"
 
 namespace curvesfm {
 
@@ -48,6 +49,7 @@ int InitCommand::run() const {
   nlohmann::json report = initialisationToJson(sequence, result);
   report["command"] = "init";
   report["curvesfm"] = versionJson();
+  report["heap"] = describe(heapPolicy());
   report["config"] = optionsToJson(*command_);
   report["options"] = table_.toJson();
   report["dataset"] = {{"dir", dataset_dir_},

@@ -15,8 +15,12 @@
 #include "apps/run_command.h"
 #include "apps/synth_command.h"
 #include "core/errors.h"
+#include "core/heap_policy.h"
 
 int main(int argc, char** argv) {
+  // Before any thread starts: see core/heap_policy.h (a page fault per page of every image's
+  // scale space, otherwise).
+  curvesfm::keepFreedMemoryInProcess();
   CLI::App app{
       "curvesfm: curve-based structure from motion (poly-Bezier curves + bundle adjustment)"};
   app.name("curvesfm");  // for the usage line; parsing a vector does not read argv[0]

@@ -24,6 +24,7 @@
 #include "core/curve_export.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
+#include "core/heap_policy.h"
 #include "core/median.h"
 #include "core/peak_memory.h"
 #include "core/trajectory_evaluation.h"
@@ -1120,6 +1121,7 @@ nlohmann::json RunCommand::reportJson(const RunInput& input, const Outcome& outc
   return {
       {"command", "run"},
       {"curvesfm", versionJson()},
+      {"heap", describe(heapPolicy())},
       {"config", optionsToJson(*command_)},
       {"options", runOptionsJson()},
       {"dataset",

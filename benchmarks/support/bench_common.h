@@ -16,6 +16,7 @@
 
 #include "core/clock.h"
 #include "core/errors.h"
+#include "core/heap_policy.h"
 
 namespace curvesfm::bench {
 
@@ -63,11 +64,13 @@ inline std::string commandLine(int argc, char** argv) {
   return command;
 }
 
-/// Runs `parse` (which fills `app`), then `run`. Exit codes as the curvesfm binary: 2 for usage
-/// errors (CLI::ParseError, or a curvesfm::Error while parsing, e.g. a bad --config file) and
-/// invalid options, 1 for any other error (one line on stderr), else run's.
+/// Runs `parse` (which fills `app`), then `run`, with freed memory kept in the process as the
+/// curvesfm binary keeps it (core/heap_policy.h; printed as `heap:`). Exit codes as the curvesfm
+/// binary: 2 for usage errors (CLI::ParseError, or a curvesfm::Error while parsing, e.g. a bad
+/// --config file) and invalid options, 1 for any other error (one line on stderr), else run's.
 template <class Parse, class Run>
 int parseWithAndRun(CLI::App& app, Parse&& parse, Run&& run) {
+  keepFreedMemoryInProcess();
   try {
     parse();
   } catch (const CLI::ParseError& e) {
@@ -77,6 +80,7 @@ int parseWithAndRun(CLI::App& app, Parse&& parse, Run&& run) {
     return 2;
   }
   try {
+    printText("heap", describe(heapPolicy()));
     return run();
   } catch (const InvalidOptions& e) {
     std::cerr << e.what() << "\n";

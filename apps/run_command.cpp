@@ -26,6 +26,7 @@
 #include "core/errors.h"
 #include "core/heap_policy.h"
 #include "core/median.h"
+#include "core/parallel.h"
 #include "core/peak_memory.h"
 #include "core/trajectory_evaluation.h"
 #include "core/tum_dataset.h"
@@ -121,6 +122,18 @@ std::vector<Pose3> initialPoses(const RunInput& input) {
   std::vector<Pose3> poses;
   for (const DatasetFrame& frame : input.frames) poses.push_back(frame.initial_cam_from_world);
   return poses;
+}
+
+// Whether the image stage runs ahead on a thread of its own: `setting` true or false, or auto:
+// when the process has a core beyond the threads of a keyframe's own stages (depth search,
+// registration, local BA). On two cores with --threads 2 the stage ahead only shared the cores:
+// its stages took 27-30 ms a kitchen keyframe against 20-26 on the main thread, for the same run
+// time within noise (docs/benchmarks.md, sessions 42 and 43).
+bool imagesAhead(const std::string& setting, const PipelineOptions& options) {
+  if (setting != "auto") return setting == "true";
+  const int keyframe_threads = std::max({options.depth.num_threads, options.registration_threads,
+                                         options.local_ba.optimizer.num_threads});
+  return availableCores() > keyframe_threads;
 }
 
 // Feeds every frame with an initial pose to the pipeline; returns the time spent waiting for
@@ -846,8 +859,10 @@ RunCommand::RunCommand(CLI::App* app) {
       ->capture_default_str();
   c->add_option("--images-ahead", images_ahead_,
                 "Load and prepare the next keyframe's image (undistortion, edges, field) on a "
-                "second thread while this one's depth search, correspondence and local BA run; the "
-                "results are the same")
+                "second thread while this one's depth search, correspondence and local BA run: "
+                "true, false, or auto (when the process has more cores than those stages' "
+                "threads); the results are the same")
+      ->check(CLI::IsMember({"auto", "true", "false"}))
       ->capture_default_str();
   c->add_option("--diagnose-frontend-poses", frontend_poses_path_,
                 "Diagnosis: lift and register curves at these poses (TUM or COLMAP model, in the "
@@ -910,6 +925,7 @@ nlohmann::json RunCommand::runOptionsJson() const {
   options["diagnose_frontend_poses"] = frontend_poses_path_;
   options["relift_passes"] = relift_passes_;
   options["images_ahead"] = images_ahead_;
+  options["images_ahead_resolved"] = imagesAhead(images_ahead_, options_);
   return options;
 }
 
@@ -1071,7 +1087,8 @@ RunCommand::Outcome RunCommand::refine(const RunInput& input) const {
     }
     outcome.pipeline = std::make_unique<Pipeline>(input.sequence.camera, outcome.options);
     outcome.image_wait_seconds +=
-        feedFrames(outcome.pipeline.get(), input, frontend_poses, outcome.options, images_ahead_);
+        feedFrames(outcome.pipeline.get(), input, frontend_poses, outcome.options,
+                   imagesAhead(images_ahead_, outcome.options));
     outcome.result = outcome.pipeline->finish();
   }
   return outcome;
@@ -1171,7 +1188,8 @@ void RunCommand::printResults(const RunInput& input, const Outcome& outcome,
                               const Evaluation& evaluation, const Written& written,
                               double seconds) const {
   const PipelineResult& result = outcome.result;
-  printSummary(input, result, seconds, images_ahead_ ? outcome.image_wait_seconds : -1.0);
+  printSummary(input, result, seconds,
+               imagesAhead(images_ahead_, options_) ? outcome.image_wait_seconds : -1.0);
   printAte(evaluation.ate, input.sequence.ground_truth_source);
   printStageMotions(evaluation.motions);
   printFinalFit(evaluation.fit);

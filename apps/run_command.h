@@ -82,7 +82,7 @@ class RunCommand {
   /// their errors, one lifted at better poses carries less. >= 0.
   int relift_passes_ = 0;
   /// Prepare the next keyframe's image stage on a second thread while this one's BA runs.
-  bool images_ahead_ = true;
+  std::string images_ahead_ = "auto";  // auto, true or false: see imagesAhead().
   ImageSequenceOptions sequence_;
   PointInitialiserOptions initialiser_;
   StartModelOptions start_model_;

@@ -19,6 +19,10 @@ namespace curvesfm {
 /// end the process instead of reaching the caller's error message.
 void runInParallel(int num_threads, const std::function<void(int thread)>& work);
 
+/// The cores this process may run on (its CPU affinity; the hardware's thread count where that
+/// is unknown), at least 1.
+int availableCores();
+
 /// Runs work(thread, i) for every i in [0, count) on up to num_threads threads (thread 0 the
 /// calling one), each thread taking the next `block` items whenever it is done with its last:
 /// a thread that shares its core with other work takes fewer, where a fixed split would leave the

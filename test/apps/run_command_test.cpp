@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/dataset_io.h"
+#include "core/parallel.h"
 #include "sim/planar_scene.h"
 #include "test/apps/run_command_fixture.h"
 #include "test/support/run_executable.h"
@@ -24,6 +25,7 @@ namespace curvesfm {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 using testing::CommandResult;
@@ -181,19 +183,28 @@ TEST_F(RunCommandTest, BadOptionsAreUsageErrors) {
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_THAT(result.output, HasSubstr("--overlay-colour-by"));
   EXPECT_THAT(result.output, HasSubstr("\"length\": expected one of none, residual, track, pull"));
+  result = run("--images-ahead sometimes");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_THAT(result.output, HasSubstr("--images-ahead"));
   EXPECT_EQ(runCurvesfm("run --out " + path("out")).exit_code, 2);
   EXPECT_FALSE(std::filesystem::exists(path("out")));
 }
 
 TEST_F(RunCommandTest, OverlaysColourTheCurvesAndDrawTheWorstOnesUnderTheirDocumentedNames) {
   const std::string out = path("planar_out");
-  const CommandResult result =
-      runCurvesfm("run --dataset " + writeShortPlanarDataset() + " --out " + out +
-                  " --overlays --overlay-colour-by track" + shortPlanarFlags());
+  // As many solver threads as cores: --images-ahead auto keeps the image stage on the main thread.
+  const std::string threads = std::to_string(availableCores());
+  const CommandResult result = runCurvesfm(
+      "run --dataset " + writeShortPlanarDataset() + " --out " + out +
+      " --overlays --overlay-colour-by track --threads " + threads + shortPlanarFlags());
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_THAT(result.output, HasSubstr(", overlays/, worst_curves/)"));
+  EXPECT_THAT(result.output, Not(HasSubstr("images ahead:")));
   const nlohmann::json report = readReport(out);
   EXPECT_EQ(report["options"]["overlay"]["colour_by"], "track");
+  EXPECT_EQ(report["options"]["images_ahead"], "auto");
+  EXPECT_EQ(report["options"]["images_ahead_resolved"], false);
+  EXPECT_TRUE(report["heap"].is_string());  // Which one depends on the allocator (sanitizers).
   EXPECT_TRUE(std::filesystem::exists(out + "/overlays/000005.png"));
   // Each worst curve drawn on its worst keyframe, under the name docs/run.md gives, and indexed.
   const nlohmann::json& statistics = report["curve_statistics"];

@@ -79,12 +79,12 @@ OptionGroupBuilder& OptionGroupBuilder::nested(const std::string& field) {
 }
 
 void OptionsTable::addFlags(CLI::App* command) const {
-  std::vector<std::pair<const CLI::Option*, int*>> thread_counts;
+  std::vector<std::pair<CLI::Option*, int*>> thread_counts;
   bool threads_taken = false;
   for (const OptionGroup& group : groups_) {
     for (const OptionField& row : group.fields) {
       if (!row.add) continue;
-      const CLI::Option* option = row.add(command, group.heading);
+      CLI::Option* option = row.add(command, group.heading);
       if (row.threads) thread_counts.emplace_back(option, row.threads);
       threads_taken = threads_taken || row.flag == "threads";
     }
@@ -98,7 +98,11 @@ void OptionsTable::addFlags(CLI::App* command) const {
             if (threads == 0) return;  // The default: every stage keeps its own.
             for (const auto& [option, count] : thread_counts) {
               // A stage's own flag wins over the global one, wherever it was given.
-              if (option->count() == 0) *count = threads;
+              if (option->count() > 0) continue;
+              *count = threads;
+              // The value the stage runs with, as report.json's config and config.yaml echo it:
+              // a run again from that config.yaml then gets the same thread counts.
+              option->default_str(std::to_string(threads));
             }
           },
           "Threads of every stage whose own flag is not given (" +

@@ -5,12 +5,14 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "apps/cli/cli_options.h"
+#include "apps/cli/config_file.h"
 #include "apps/cli/option_tables.h"
 #include "core/errors.h"
 
@@ -151,6 +153,17 @@ TEST_F(PipelineTableTest, ThreadsSetsEveryStageWhoseOwnFlagIsNotGiven) {
   EXPECT_EQ(options_.local_ba.optimizer.num_threads, 3);
   EXPECT_EQ(options_.tracking.num_threads, 3);
   EXPECT_EQ(options_.global_ba.optimizer.num_threads, 1);
+}
+
+// config.yaml gives every flag; were a stage's count echoed as its default, a run from that file
+// would take it as given and keep one thread where the first run had --threads.
+TEST_F(PipelineTableTest, TheEchoedConfigCarriesTheThreadCountsThreadsSet) {
+  parse({"--threads", "3", "--global-ba-threads", "1"});
+  std::map<std::string, std::string> echoed;
+  for (const auto& [name, value] : effectiveOptions(app_)) echoed[name] = value;
+  EXPECT_EQ(echoed["local-ba-threads"], "3");
+  EXPECT_EQ(echoed["global-ba-threads"], "1");
+  EXPECT_EQ(echoed["threads"], "3");
 }
 
 TEST_F(PipelineTableTest, RangeErrorsNameTheFlagOfTheirPlace) {

@@ -925,7 +925,6 @@ nlohmann::json RunCommand::runOptionsJson() const {
   options["diagnose_frontend_poses"] = frontend_poses_path_;
   options["relift_passes"] = relift_passes_;
   options["images_ahead"] = images_ahead_;
-  options["images_ahead_resolved"] = imagesAhead(images_ahead_, options_);
   return options;
 }
 
@@ -994,6 +993,7 @@ struct RunCommand::Outcome {
   std::optional<StartModelEstimate> start_model;
   bool tied_start = false;
   int relift_passes = 0;
+  bool images_ahead = false;  // --images-ahead as resolved for this run.
   double image_wait_seconds = 0.0;
 };
 
@@ -1079,6 +1079,7 @@ RunCommand::Outcome RunCommand::refine(const RunInput& input) const {
   outcome.tied_start = outcome.options.ba.start_prior && !options_.ba.start_prior;
   outcome.relift_passes =
       std::max(relift_passes_, outcome.tied_start ? start_model_.relift_passes : 0);
+  outcome.images_ahead = imagesAhead(images_ahead_, outcome.options);
   std::vector<Pose3> frontend_poses = input.frontend_poses;
   for (int pass = 0; pass <= outcome.relift_passes; ++pass) {
     if (pass > 0) {
@@ -1086,9 +1087,8 @@ RunCommand::Outcome RunCommand::refine(const RunInput& input) const {
       frontend_poses = reliftPoses(input, frontend_poses, outcome.result);
     }
     outcome.pipeline = std::make_unique<Pipeline>(input.sequence.camera, outcome.options);
-    outcome.image_wait_seconds +=
-        feedFrames(outcome.pipeline.get(), input, frontend_poses, outcome.options,
-                   imagesAhead(images_ahead_, outcome.options));
+    outcome.image_wait_seconds += feedFrames(outcome.pipeline.get(), input, frontend_poses,
+                                             outcome.options, outcome.images_ahead);
     outcome.result = outcome.pipeline->finish();
   }
   return outcome;
@@ -1135,12 +1135,14 @@ nlohmann::json RunCommand::reportJson(const RunInput& input, const Outcome& outc
   nlohmann::json frames = nlohmann::json::array();
   for (const KeyframeStats& s : result.frames) frames.push_back(frameToJson(s));
   const CurveGrowth growth = curveGrowth(result.frames);
+  nlohmann::json options = runOptionsJson();
+  options["images_ahead_resolved"] = outcome.images_ahead;
   return {
       {"command", "run"},
       {"curvesfm", versionJson()},
       {"heap", describe(heapPolicy())},
       {"config", optionsToJson(*command_)},
-      {"options", runOptionsJson()},
+      {"options", options},
       {"dataset",
        {{"dir", dataset_dir_},
         {"layout", d.layout},
@@ -1188,8 +1190,7 @@ void RunCommand::printResults(const RunInput& input, const Outcome& outcome,
                               const Evaluation& evaluation, const Written& written,
                               double seconds) const {
   const PipelineResult& result = outcome.result;
-  printSummary(input, result, seconds,
-               imagesAhead(images_ahead_, options_) ? outcome.image_wait_seconds : -1.0);
+  printSummary(input, result, seconds, outcome.images_ahead ? outcome.image_wait_seconds : -1.0);
   printAte(evaluation.ate, input.sequence.ground_truth_source);
   printStageMotions(evaluation.motions);
   printFinalFit(evaluation.fit);

@@ -19,7 +19,7 @@ enum class HeapPolicy {
 /// and allocated again is faulted in again page by page. OpenCV's SIFT allocates its scale space
 /// afresh for every image (about 1.4 GiB on a 3072 x 2048 photo), and on the virtual machine we
 /// measured a page fault cost about 6 us: fountain-P11's initialiser made 3.3 million of them,
-/// 20 s of its 48-59 s (docs/benchmarks.md, session 43). Peak memory measured within 2 % or
+/// 20 s of its 48-59 s (docs/benchmarks.md, session 43). Peak memory measured within 3 % or
 /// lower (what is kept had been in use, and is reused rather than mapped anew).
 /// Call once, first thing in main(), before any thread starts. Left alone when the environment's
 /// GLIBC_TUNABLES sets any glibc.malloc.* tunable, so a user can still choose (or restore

@@ -88,9 +88,19 @@ std::vector<fs::path> listFiles(const fs::path& dir,
   return files;
 }
 
+constexpr const char* kImageExtensions[] = {".png", ".jpg", ".jpeg", ".ppm",
+                                            ".pgm", ".bmp", ".tif",  ".tiff"};
+
+std::string imageExtensionsText() {
+  std::string text;
+  for (const char* extension : kImageExtensions)
+    text += (text.empty() ? "" : ", ") + std::string(extension);
+  return text;
+}
+
 bool isImageName(const std::string& name) {
   const std::string lower = lowerCase(name);
-  for (const char* extension : {".png", ".jpg", ".jpeg", ".ppm", ".pgm", ".bmp", ".tif", ".tiff"}) {
+  for (const char* extension : kImageExtensions) {
     if (endsWith(lower, extension)) return true;
   }
   return false;
@@ -111,7 +121,7 @@ struct LayoutContents {
   std::optional<CameraIntrinsics> intrinsics;  ///< width/height 0: take the first image's.
   std::string camera_source;                   ///< The file the intrinsics came from.
   std::string camera_looked_for;               ///< Without intrinsics: what was looked for.
-  std::vector<StampedPose> ground_truth;       ///< TUM only; per-frame layouts use frames.
+  std::vector<StampedPose> ground_truth;       ///< TUM and images; the others use frames.
   std::string ground_truth_source;
 };
 
@@ -248,22 +258,27 @@ DecomposedProjection decomposeProjection(Matrix34d P, const std::string& path) {
 
 // --- TUM RGB-D ---------------------------------------------------------------------------------
 
-LayoutContents readTum(const fs::path& dir) {
-  LayoutContents c;
+// DIR/camera.yaml and DIR/groundtruth.txt (a whole TUM trajectory), where present.
+void readCameraYamlAndGroundTruth(const fs::path& dir, LayoutContents* c) {
   const std::string camera_yaml = joinPath(dir, "camera.yaml");
   if (fs::exists(camera_yaml)) {
-    c.intrinsics = readCameraYaml(camera_yaml).intrinsics();
-    c.camera_source = camera_yaml;
+    c->intrinsics = readCameraYaml(camera_yaml).intrinsics();
+    c->camera_source = camera_yaml;
   } else {
-    c.camera_looked_for = camera_yaml;
-  }
-  for (const ImageEntry& entry : readImageList(joinPath(dir, "rgb.txt"))) {
-    c.frames.push_back({entry.timestamp, entry.path, std::nullopt});
+    c->camera_looked_for = camera_yaml;
   }
   const std::string ground_truth = joinPath(dir, "groundtruth.txt");
   if (fs::exists(ground_truth)) {
-    c.ground_truth = readTrajectory(ground_truth);
-    c.ground_truth_source = ground_truth;
+    c->ground_truth = readTrajectory(ground_truth);
+    c->ground_truth_source = ground_truth;
+  }
+}
+
+LayoutContents readTum(const fs::path& dir) {
+  LayoutContents c;
+  readCameraYamlAndGroundTruth(dir, &c);
+  for (const ImageEntry& entry : readImageList(joinPath(dir, "rgb.txt"))) {
+    c.frames.push_back({entry.timestamp, entry.path, std::nullopt});
   }
   return c;
 }
@@ -468,26 +483,32 @@ std::optional<fs::path> projectionFolder(const fs::path& dir) {
   return std::nullopt;
 }
 
-// images/ itself, or its one sub-folder (Pavilion: images/midday/).
+// `folder` itself when it holds images, else its one sub-folder that does (Pavilion:
+// images/midday/); nothing when there is none, IoError when there are several.
+std::optional<fs::path> imagesIn(const fs::path& folder) {
+  if (!isDirectory(folder)) return std::nullopt;
+  if (!listImages(folder).empty()) return folder;
+  std::vector<fs::path> subfolders;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
+    if (entry.is_directory() && !listImages(entry.path()).empty()) {
+      subfolders.push_back(entry.path());
+    }
+  }
+  if (subfolders.size() == 1) return subfolders[0];
+  if (subfolders.size() > 1) {
+    std::sort(subfolders.begin(), subfolders.end());
+    std::string names;
+    for (const fs::path& s : subfolders) names += " " + s.filename().string();
+    throw IoError(folder.string(), "holds no images but several folders of them (" +
+                                       names.substr(1) +
+                                       "): keep one (e.g. in a copy of the dataset folder)");
+  }
+  return std::nullopt;
+}
+
 fs::path projectionImageFolder(const fs::path& dir) {
   for (const char* name : kProjectionImageFolders) {
-    const fs::path folder = dir / name;
-    if (!isDirectory(folder)) continue;
-    if (!listImages(folder).empty()) return folder;
-    std::vector<fs::path> subfolders;
-    for (const fs::directory_entry& entry : fs::directory_iterator(folder)) {
-      if (entry.is_directory() && !listImages(entry.path()).empty()) {
-        subfolders.push_back(entry.path());
-      }
-    }
-    if (subfolders.size() == 1) return subfolders[0];
-    if (subfolders.size() > 1) {
-      std::string names;
-      for (const fs::path& s : subfolders) names += " " + s.filename().string();
-      throw IoError(folder.string(), "holds no images but several folders of them (" +
-                                         names.substr(1) +
-                                         "): keep one (e.g. in a copy of the dataset folder)");
-    }
+    if (const std::optional<fs::path> folder = imagesIn(dir / name)) return *folder;
   }
   throw IoError(dir.string(), "no image folder: looked for images/ and visualize/");
 }
@@ -653,6 +674,33 @@ LayoutContents readSevenScenes(const fs::path& dir) {
   return c;
 }
 
+// --- A plain folder of images -------------------------------------------------------------------
+
+// The images directly in `dir`, or in dir/images/ (or its one sub-folder). Other layouts keep
+// their images in such folders too, so detection tries every other layout first.
+std::optional<fs::path> plainImageFolder(const fs::path& dir) {
+  if (!listImages(dir).empty()) return dir;
+  return imagesIn(dir / "images");
+}
+
+// What most people have: the images of one calibrated camera in file-name order. The intrinsics
+// come from --camera or DIR/camera.yaml; DIR/groundtruth.txt, if present, is a TUM trajectory
+// whose times are the images' indices 0, 1, 2, ... (as every layout without times numbers them).
+LayoutContents readPlainImages(const fs::path& dir) {
+  const std::optional<fs::path> folder = plainImageFolder(dir);
+  if (!folder) {
+    throw IoError(dir.string(), "holds no images (looked for " + imageExtensionsText() +
+                                    " files in it and in images/)");
+  }
+  LayoutContents c;
+  readCameraYamlAndGroundTruth(dir, &c);
+  const std::vector<fs::path> images = listImages(*folder);
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    c.frames.push_back({static_cast<double>(i), images[i].string(), std::nullopt});
+  }
+  return c;
+}
+
 // --- Layout detection ---------------------------------------------------------------------------
 
 struct LayoutSignature {
@@ -783,10 +831,13 @@ DatasetLayout detectDatasetLayout(const std::string& dir) {
     throw IoError(dir, "looks like several dataset layouts (" + layoutNames(layouts) +
                            "): pass the layout (one of " + layoutNames(layouts) + ")");
   }
+  // Last, since the other layouts hold images too.
+  if (plainImageFolder(dir)) return DatasetLayout::kImages;
   std::string looked_for;
   for (const LayoutSignature& s : kSignatures) {
     looked_for += (looked_for.empty() ? "" : ", ") + std::string(s.looks_for);
   }
+  looked_for += ", image files in it or in images/ (images)";
   // Published archives often wrap the sequence in a folder (KITTI_sequence_1/, data/).
   std::string hint;
   std::vector<fs::path> subfolders;
@@ -796,7 +847,11 @@ DatasetLayout detectDatasetLayout(const std::string& dir) {
   std::sort(subfolders.begin(), subfolders.end());
   for (const fs::path& sub : subfolders) {
     const std::vector<DatasetLayout> inside = matchingLayouts(sub);
-    if (!inside.empty()) hint += "; " + sub.string() + " looks like " + layoutNames(inside);
+    if (!inside.empty()) {
+      hint += "; " + sub.string() + " looks like " + layoutNames(inside);
+    } else if (!listImages(sub).empty()) {
+      hint += "; " + sub.string() + " holds images";
+    }
   }
   throw IoError(dir, "no known dataset layout: looked for " + looked_for + hint);
 }
@@ -825,6 +880,9 @@ ImageSequence loadImageSequence(const std::string& dir, const ImageSequenceOptio
       break;
     case DatasetLayout::kSevenScenes:
       c = readSevenScenes(dir);
+      break;
+    case DatasetLayout::kImages:
+      c = readPlainImages(dir);
       break;
     case DatasetLayout::kAuto:
       break;

@@ -28,18 +28,20 @@ enum class DatasetLayout {
   kProjection,   ///< Images with one 3x4 projection matrix file each (Pavilion, PMVS).
   kStrecha,      ///< Strecha / EPFL: images/*.jpg and gt_dense_cameras/*.camera.
   kSevenScenes,  ///< Microsoft 7-Scenes: frame-*.color.png|jpg and frame-*.pose.txt.
+  kImages,       ///< A plain folder of images (or its images/), camera.yaml or --camera.
 };
 
 template <>
 struct EnumNames<DatasetLayout> {
-  static constexpr std::array<std::pair<DatasetLayout, const char*>, 7> kNames = {
+  static constexpr std::array<std::pair<DatasetLayout, const char*>, 8> kNames = {
       {{DatasetLayout::kAuto, "auto"},
        {DatasetLayout::kTum, "tum"},
        {DatasetLayout::kKitti, "kitti"},
        {DatasetLayout::kMiddlebury, "middlebury"},
        {DatasetLayout::kProjection, "projection"},
        {DatasetLayout::kStrecha, "strecha"},
-       {DatasetLayout::kSevenScenes, "7scenes"}}};
+       {DatasetLayout::kSevenScenes, "7scenes"},
+       {DatasetLayout::kImages, "images"}}};
 };
 
 /// What to read from a dataset folder.
@@ -75,8 +77,9 @@ struct ImageSequence {
   std::vector<SequenceImage> images;  ///< In the layout's order, after stride and max_frames.
   /// Camera-to-world poses (x_world = R x_cam + t, as TUM trajectories) in the dataset's own
   /// world frame and unit (metres for TUM, KITTI, Middlebury, Strecha, 7-Scenes; Blender units
-  /// for Pavilion), stamped with the images' timestamps. TUM: the whole groundtruth.txt; every
-  /// other layout: one pose per entry of `images`, in the same order. Empty without ground truth.
+  /// for Pavilion), stamped with the images' timestamps. TUM and images: the whole
+  /// groundtruth.txt; every other layout: one pose per entry of `images`, in the same order.
+  /// Empty without ground truth.
   std::vector<StampedPose> ground_truth;
   std::string ground_truth_source;  ///< The file(s) it came from; empty without ground truth.
 };
@@ -89,9 +92,10 @@ ImageSequence loadImageSequence(const std::string& dir, const ImageSequenceOptio
 
 /// The layout of `dir` from the files present: rgb.txt -> tum; calib.txt or image_0/ -> kitti;
 /// *_par.txt -> middlebury; *.camera (in dir or gt_dense_cameras/) -> strecha; cameras/ or txt/
-/// of projection matrix files -> projection; frame-*.pose.txt -> 7scenes. IoError naming the
-/// folder and listing the layouts looked for when none or several match (and the sub-folders
-/// that do match one, if any).
+/// of projection matrix files -> projection; frame-*.pose.txt -> 7scenes; and when none of
+/// these matches, image files in dir or in dir/images/ (or its one sub-folder) -> images. IoError
+/// naming the folder and listing the layouts looked for when none or several match (and the
+/// sub-folders that do match one, if any).
 DatasetLayout detectDatasetLayout(const std::string& dir);
 
 /// Parses the camera string of ImageSequenceOptions::camera for an image of width x height

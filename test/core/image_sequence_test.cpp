@@ -101,11 +101,13 @@ TEST_F(ImageSequenceTest, CameraStringOverridesAndTakesTheImageSize) {
   EXPECT_TRUE(s.ground_truth.empty());
 }
 
-TEST_F(ImageSequenceTest, TumWithoutIntrinsicsSaysToPassCamera) {
+TEST_F(ImageSequenceTest, TumOrPlainFolderWithoutIntrinsicsSaysToPassCamera) {
   image("a.png");
   write("rgb.txt", "0 a.png\n");
-  EXPECT_THAT([&] { load(); },
-              ThrowsMessage<IoError>(AllOf(HasSubstr(path("camera.yaml")), HasSubstr("--camera"))));
+  for (const DatasetLayout layout : {DatasetLayout::kTum, DatasetLayout::kImages}) {
+    EXPECT_THAT([&] { load(layout); }, ThrowsMessage<IoError>(AllOf(HasSubstr(path("camera.yaml")),
+                                                                    HasSubstr("--camera"))));
+  }
 }
 
 TEST_F(ImageSequenceTest, MalformedCameraStringNamesTheField) {
@@ -416,6 +418,75 @@ TEST_F(ImageSequenceTest, SevenScenesReadsFramePoses) {
   ASSERT_EQ(s.ground_truth.size(), 2u);
   expectPoseNear(s.ground_truth[1].world_from_cam, pose);
   EXPECT_EQ(s.camera.cx(), 3.5);
+}
+
+// --- A plain folder of images ------------------------------------------------------------------
+
+TEST_F(ImageSequenceTest, PlainFolderReadsImagesInNameOrderWithCameraYamlAndGroundTruth) {
+  for (const char* name : {"img10.png", "img2.jpg", "img1.png"}) image(name);
+  write("notes.txt", "not an image\n");
+  CameraIntrinsics k;
+  k.width = 8;
+  k.height = 6;
+  k.fx = 9.0;
+  writeCameraYaml(path("camera.yaml"), Camera(k));
+  write("groundtruth.txt", "0 0 0 0 0 0 0 1\n1 1 0 0 0 0 0 1\n2 2 0 0 0 0 0 1\n");
+  const ImageSequence s = load();
+  EXPECT_EQ(s.layout, "images");
+  ASSERT_EQ(s.images.size(), 3u);
+  EXPECT_EQ(s.images[0].name, "img1.png");
+  EXPECT_EQ(s.images[1].name, "img2.jpg");
+  EXPECT_EQ(s.images[2].name, "img10.png");
+  EXPECT_EQ(s.images[2].timestamp, 2.0);
+  EXPECT_EQ(s.camera.fx(), 9.0);
+  EXPECT_EQ(s.camera_source, path("camera.yaml"));
+  ASSERT_EQ(s.ground_truth.size(), 3u);
+  EXPECT_EQ(s.ground_truth[2].world_from_cam.translation().x(), 2.0);
+  EXPECT_EQ(s.ground_truth_source, path("groundtruth.txt"));
+}
+
+TEST_F(ImageSequenceTest, PlainImagesMayLieInImagesOrItsOneSubfolder) {
+  image("images/b.png");
+  image("images/a.png");
+  ImageSequence s = load(DatasetLayout::kAuto, "10,10,3,2");
+  EXPECT_EQ(s.layout, "images");
+  ASSERT_EQ(s.images.size(), 2u);
+  EXPECT_EQ(s.images[0].image_path, path("images/a.png"));
+  EXPECT_TRUE(s.ground_truth.empty());
+  fs::rename(path("images"), path("camera_1"));
+  image("images/camera_1/a.png");
+  s = load(DatasetLayout::kAuto, "10,10,3,2");
+  EXPECT_EQ(s.images[0].image_path, path("images/camera_1/a.png"));
+  image("images/camera_2/a.png");
+  EXPECT_THAT([&] { load(DatasetLayout::kAuto, "10,10,3,2"); },
+              ThrowsMessage<IoError>(
+                  AllOf(HasSubstr(path("images")), HasSubstr("several folders of them (camera_1 "
+                                                             "camera_2)"))));
+}
+
+TEST_F(ImageSequenceTest, PlainFolderNamesAFileThatIsNoImage) {
+  image("a.png");
+  write("b.png", "not a png\n");
+  EXPECT_THAT([&] { load(DatasetLayout::kAuto, "10,10,3,2"); },
+              ThrowsMessage<IoError>(HasSubstr(path("b.png") + ": cannot decode")));
+}
+
+TEST_F(ImageSequenceTest, OtherLayoutsComeBeforeAPlainFolder) {
+  image("a.png");
+  write("rgb.txt", "0 a.png\n");
+  EXPECT_EQ(load(DatasetLayout::kAuto, "10,10,3,2").layout, "tum");
+}
+
+TEST_F(ImageSequenceTest, AFolderWithoutImagesSaysWhereItLooked) {
+  write("notes.txt", "not an image\n");
+  image("sequence_1/a.png");
+  EXPECT_THAT([&] { load(); },
+              ThrowsMessage<IoError>(AllOf(HasSubstr("no known dataset layout"),
+                                           HasSubstr("image files in it or in images/ (images)"),
+                                           HasSubstr(path("sequence_1") + " holds images"))));
+  EXPECT_THAT([&] { load(DatasetLayout::kImages, "10,10,3,2"); },
+              ThrowsMessage<IoError>(
+                  AllOf(HasSubstr(dir_.string() + ": holds no images"), HasSubstr(".png, .jpg"))));
 }
 
 }  // namespace

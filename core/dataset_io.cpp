@@ -1,6 +1,7 @@
 #include "core/dataset_io.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -156,7 +157,116 @@ struct YamlFile {
     }
     return static_cast<int>(value);
   }
+
+  // The numbers of a matrix key as OpenCV writes it (!!opencv-matrix) or ROS camera_info does
+  // ({rows, cols, data}): its data in row order; `counts` lists the accepted sizes.
+  std::vector<double> matrixData(const std::string& key, std::initializer_list<int> counts) const {
+    const cv::FileNode data = storage[key]["data"];
+    std::string sizes;
+    for (const int count : counts) sizes += (sizes.empty() ? "" : " or ") + std::to_string(count);
+    const std::string expected = "key " + key + " (a matrix of " + sizes + " numbers: data)";
+    const int line = lineOfKey(text, key);
+    if (!data.isSeq()) throw ParseError(path, line, expected, describeNode(storage[key]));
+    std::vector<double> values;
+    for (const cv::FileNode& value : data) {
+      if (!value.isInt() && !value.isReal()) {
+        throw ParseError(path, line, expected, "an entry " + describeNode(value));
+      }
+      if (!std::isfinite(value.real())) {
+        throw ParseError(path, line, expected, "an entry " + formatNumber(value.real()));
+      }
+      values.push_back(value.real());
+    }
+    if (std::find(counts.begin(), counts.end(), static_cast<int>(values.size())) == counts.end()) {
+      throw ParseError(path, line, expected, std::to_string(values.size()) + " numbers");
+    }
+    return values;
+  }
 };
+
+// ORB-SLAM2's keys: Camera.fx ... Camera.k3, Camera.width, Camera.height.
+CameraIntrinsics orbSlamIntrinsics(const YamlFile& file) {
+  if (file.storage["Camera.fx"].isNone()) {
+    throw ParseError(file.path, 0,
+                     "key Camera.fx (a number; or camera_matrix, image_width and image_height as "
+                     "OpenCV's calibration and ROS camera_info write them)",
+                     "no such key");
+  }
+  CameraIntrinsics intrinsics;
+  intrinsics.fx = file.positiveNumber("Camera.fx");
+  intrinsics.fy = file.positiveNumber("Camera.fy");
+  intrinsics.cx = file.number("Camera.cx");
+  intrinsics.cy = file.number("Camera.cy");
+  intrinsics.k1 = file.number("Camera.k1", 0.0);
+  intrinsics.k2 = file.number("Camera.k2", 0.0);
+  intrinsics.p1 = file.number("Camera.p1", 0.0);
+  intrinsics.p2 = file.number("Camera.p2", 0.0);
+  intrinsics.k3 = file.number("Camera.k3", 0.0);
+  intrinsics.width = file.pixelCount("Camera.width");
+  intrinsics.height = file.pixelCount("Camera.height");
+  return intrinsics;
+}
+
+// camera_matrix, 3x3 with zero skew: fx, fy, cx, cy.
+std::array<double, 4> calibrationMatrix(const YamlFile& file) {
+  const std::vector<double> K = file.matrixData("camera_matrix", {9});
+  if (!(K[0] > 0.0 && K[4] > 0.0) || K[1] != 0.0 || K[3] != 0.0 || K[6] != 0.0 || K[7] != 0.0 ||
+      K[8] != 1.0) {
+    std::string found = "[";
+    for (int i = 0; i < 9; ++i)
+      found += formatNumber(K[i]) + (i == 8 ? "]" : i % 3 == 2 ? "; " : " ");
+    throw ParseError(file.path, lineOfKey(file.text, "camera_matrix"),
+                     "key camera_matrix = [fx 0 cx; 0 fy cy; 0 0 1] with fx, fy > 0 and zero skew",
+                     found);
+  }
+  return {K[0], K[4], K[2], K[5]};
+}
+
+// distortion_coefficients (k1 k2 p1 p2 k3; zeros when absent). OpenCV's rational and thin-prism
+// terms (coefficients 6 to 14) are accepted only as zeros, since our camera model stops at k3.
+std::array<double, 5> calibrationDistortion(const YamlFile& file) {
+  const cv::FileNode model = file.storage["distortion_model"];
+  if (model.isString() && model.string() != "plumb_bob" &&
+      model.string() != "rational_polynomial") {
+    throw ParseError(file.path, lineOfKey(file.text, "distortion_model"),
+                     "key distortion_model plumb_bob (radial-tangential, OpenCV's model)",
+                     quoteToken(model.string()));
+  }
+  std::array<double, 5> k1_k2_p1_p2_k3{};
+  if (file.storage["distortion_coefficients"].isNone()) return k1_k2_p1_p2_k3;
+  const std::vector<double> d = file.matrixData("distortion_coefficients", {0, 4, 5, 8, 12, 14});
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    if (i < k1_k2_p1_p2_k3.size()) {
+      k1_k2_p1_p2_k3[i] = d[i];
+    } else if (d[i] != 0.0) {
+      throw ParseError(file.path, lineOfKey(file.text, "distortion_coefficients"),
+                       "key distortion_coefficients with k1 k2 p1 p2 k3 only (any further "
+                       "coefficient 0: the camera model is radial-tangential)",
+                       "coefficient " + std::to_string(i + 1) + " = " + formatNumber(d[i]));
+    }
+  }
+  return k1_k2_p1_p2_k3;
+}
+
+// What OpenCV's calibration sample and ROS camera_info write: camera_matrix,
+// distortion_coefficients (optional), image_width, image_height.
+CameraIntrinsics calibrationIntrinsics(const YamlFile& file) {
+  const std::array<double, 4> K = calibrationMatrix(file);
+  const std::array<double, 5> d = calibrationDistortion(file);
+  CameraIntrinsics intrinsics;
+  intrinsics.fx = K[0];
+  intrinsics.fy = K[1];
+  intrinsics.cx = K[2];
+  intrinsics.cy = K[3];
+  intrinsics.k1 = d[0];
+  intrinsics.k2 = d[1];
+  intrinsics.p1 = d[2];
+  intrinsics.p2 = d[3];
+  intrinsics.k3 = d[4];
+  intrinsics.width = file.pixelCount("image_width");
+  intrinsics.height = file.pixelCount("image_height");
+  return intrinsics;
+}
 
 }  // namespace
 
@@ -272,19 +382,9 @@ Camera readCameraYaml(const std::string& path) {
     throw ParseError(path, 0, "a YAML mapping of Camera.* keys", describeNode(root));
   }
   const YamlFile file{path, text, storage};
-  CameraIntrinsics intrinsics;
-  intrinsics.fx = file.positiveNumber("Camera.fx");
-  intrinsics.fy = file.positiveNumber("Camera.fy");
-  intrinsics.cx = file.number("Camera.cx");
-  intrinsics.cy = file.number("Camera.cy");
-  intrinsics.k1 = file.number("Camera.k1", 0.0);
-  intrinsics.k2 = file.number("Camera.k2", 0.0);
-  intrinsics.p1 = file.number("Camera.p1", 0.0);
-  intrinsics.p2 = file.number("Camera.p2", 0.0);
-  intrinsics.k3 = file.number("Camera.k3", 0.0);
-  intrinsics.width = file.pixelCount("Camera.width");
-  intrinsics.height = file.pixelCount("Camera.height");
-  return Camera(intrinsics);
+  const bool calibration_form =
+      !root.isNone() && !storage["camera_matrix"].isNone() && storage["Camera.fx"].isNone();
+  return Camera(calibration_form ? calibrationIntrinsics(file) : orbSlamIntrinsics(file));
 }
 
 void writeCameraYaml(const std::string& path, const Camera& camera) {

@@ -74,10 +74,15 @@ void writeTrajectory(const std::string& path, const std::vector<StampedPose>& po
 std::vector<StampedPose> stampedPoses(const std::vector<double>& timestamps,
                                       const std::vector<Pose3>& cam_from_world);
 
-/// Reads an OpenCV FileStorage YAML camera file with ORB-SLAM2-style keys. Required: Camera.fx,
-/// Camera.fy (> 0), Camera.cx, Camera.cy, Camera.width, Camera.height (positive whole numbers);
-/// optional, default 0: Camera.k1, Camera.k2, Camera.p1, Camera.p2, Camera.k3. Other keys are
-/// ignored. The "%YAML:1.0" / "%YAML 1.0" header is optional.
+/// Reads an OpenCV FileStorage YAML camera file in one of two forms:
+///  - ORB-SLAM2's keys. Required: Camera.fx, Camera.fy (> 0), Camera.cx, Camera.cy, Camera.width,
+///    Camera.height (positive whole numbers); optional, default 0: Camera.k1, Camera.k2,
+///    Camera.p1, Camera.p2, Camera.k3.
+///  - What OpenCV's calibration sample and ROS camera_info write (when there is no Camera.fx):
+///    camera_matrix (3x3, as !!opencv-matrix or {rows, cols, data}; zero skew), image_width,
+///    image_height; optional distortion_coefficients (k1 k2 p1 p2 [k3], or OpenCV's 8, 12 or 14
+///    with every coefficient after k3 zero) and distortion_model (plumb_bob).
+/// Other keys are ignored. The "%YAML:1.0" / "%YAML 1.0" header is optional.
 /// Errors: IoError if the file cannot be read; ParseError for YAML that OpenCV rejects (with the
 /// line OpenCV reports and its message), for a missing required key (line 0), and for a value
 /// that is not a finite number or out of range (with the key's line when it can be located).

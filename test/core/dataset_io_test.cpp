@@ -286,10 +286,104 @@ TEST_F(DatasetIoTest, ReadCameraYamlWithoutFxIsParseError) {
   text.erase(text.find("Camera.fx: 517.306408\n"), std::string("Camera.fx: 517.306408\n").size());
   const std::string path = write("camera.yaml", text);
   EXPECT_EQ(errorMessage<ParseError>([&] { readCameraYaml(path); }),
-            "ParseError: " + path + ": expected key Camera.fx (a number), found no such key");
+            "ParseError: " + path +
+                ": expected key Camera.fx (a number; or camera_matrix, image_width and "
+                "image_height as OpenCV's calibration and ROS camera_info write them), found no "
+                "such key");
   const std::string empty = write("empty.yaml", "");
   EXPECT_THAT(errorMessage<ParseError>([&] { readCameraYaml(empty); }),
-              HasSubstr(empty + ": expected key Camera.fx (a number), found no such key"));
+              HasSubstr(empty + ": expected key Camera.fx (a number; or camera_matrix"));
+}
+
+// What OpenCV's samples/cpp/calibration.cpp writes (abridged).
+constexpr char kOpenCvCalibration[] = R"(%YAML:1.0
+---
+calibration_time: "Sun 06 Dec 2026 05:40:00 UTC"
+image_width: 640
+image_height: 480
+flags: 0
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 5.2e+02, 0., 3.195e+02, 0., 5.21e+02, 2.395e+02, 0., 0., 1. ]
+distortion_coefficients: !!opencv-matrix
+   rows: 5
+   cols: 1
+   dt: d
+   data: [ 0.1, -0.2, 1.0e-03, -2.0e-03, 0.05 ]
+avg_reprojection_error: 0.31
+)";
+
+// ROS camera_info as camera_calibration writes it (abridged; no YAML directive).
+constexpr char kRosCameraInfo[] = R"(image_width: 752
+image_height: 480
+camera_name: narrow_stereo
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [458.654, 0, 367.215, 0, 457.296, 248.375, 0, 0, 1]
+distortion_model: plumb_bob
+distortion_coefficients:
+  rows: 1
+  cols: 5
+  data: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05, 0]
+rectification_matrix:
+  rows: 3
+  cols: 3
+  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]
+)";
+
+TEST_F(DatasetIoTest, ReadCameraYamlParsesOpenCvCalibrationOutput) {
+  const CameraIntrinsics c = readCameraYaml(write("camera.yaml", kOpenCvCalibration)).intrinsics();
+  EXPECT_DOUBLE_EQ(c.fx, 520.0);
+  EXPECT_DOUBLE_EQ(c.fy, 521.0);
+  EXPECT_DOUBLE_EQ(c.cx, 319.5);
+  EXPECT_DOUBLE_EQ(c.cy, 239.5);
+  EXPECT_DOUBLE_EQ(c.k1, 0.1);
+  EXPECT_DOUBLE_EQ(c.k2, -0.2);
+  EXPECT_DOUBLE_EQ(c.p1, 1e-3);
+  EXPECT_DOUBLE_EQ(c.p2, -2e-3);
+  EXPECT_DOUBLE_EQ(c.k3, 0.05);
+  EXPECT_EQ(c.width, 640);
+  EXPECT_EQ(c.height, 480);
+}
+
+TEST_F(DatasetIoTest, ReadCameraYamlParsesRosCameraInfo) {
+  const CameraIntrinsics c = readCameraYaml(write("camera.yaml", kRosCameraInfo)).intrinsics();
+  EXPECT_DOUBLE_EQ(c.fx, 458.654);
+  EXPECT_DOUBLE_EQ(c.cy, 248.375);
+  EXPECT_DOUBLE_EQ(c.k1, -0.28340811);
+  EXPECT_DOUBLE_EQ(c.p2, 1.76187114e-05);
+  EXPECT_DOUBLE_EQ(c.k3, 0.0);
+  EXPECT_EQ(c.width, 752);
+}
+
+TEST_F(DatasetIoTest, ReadCameraYamlCalibrationFormNamesWhatItCannotModel) {
+  const auto message = [&](const std::string& from, const std::string& to) {
+    std::string text = kOpenCvCalibration;
+    text.replace(text.find(from), from.size(), to);
+    const std::string path = write("camera.yaml", text);
+    return errorMessage<ParseError>([&] { readCameraYaml(path); });
+  };
+  // OpenCV's rational model: 8 coefficients, k4 not zero.
+  EXPECT_THAT(
+      message("rows: 5\n   cols: 1\n   dt: d\n   data: [ 0.1, -0.2, 1.0e-03, -2.0e-03, 0.05 ]",
+              "rows: 8\n   cols: 1\n   dt: d\n   data: [ 0.1, -0.2, 0, 0, 0.05, 0.3, 0, 0 ]"),
+      HasSubstr(":12: expected key distortion_coefficients with k1 k2 p1 p2 k3 only "
+                "(any further coefficient 0: the camera model is radial-tangential), "
+                "found coefficient 6 = 0.3"));
+  EXPECT_THAT(message("0., 0., 1. ]", "0., 1. ]"),
+              HasSubstr(":7: expected key camera_matrix (a matrix of 9 numbers: data), found 8 "
+                        "numbers"));
+  EXPECT_THAT(message("5.2e+02, 0.,", "5.2e+02, 0.5,"),
+              HasSubstr(":7: expected key camera_matrix = [fx 0 cx; 0 fy cy; 0 0 1] with fx, fy > "
+                        "0 and zero skew, found [520 0.5 319.5; 0 521 239.5; 0 0 1]"));
+  EXPECT_THAT(message("image_height: 480\n", ""),
+              HasSubstr("expected key image_height (a number), found no such key"));
+  EXPECT_THAT(message("flags: 0\n", "distortion_model: equidistant\n"),
+              HasSubstr(":6: expected key distortion_model plumb_bob (radial-tangential, "
+                        "OpenCV's model), found \"equidistant\""));
 }
 
 TEST_F(DatasetIoTest, ReadCameraYamlNonNumericValueNamesKeyAndLine) {

@@ -48,7 +48,7 @@ OptionGroupBuilder& OptionGroupBuilder::text(const std::string& field, const std
               }
               return "";
             },
-            type_name))
+            ""))
         ->type_name(type_name)
         ->default_str(print())
         ->group(heading);

@@ -21,6 +21,7 @@
 #include "apps/cli/report_json.h"
 #include "core/check.h"
 #include "core/clock.h"
+#include "core/colmap_model.h"
 #include "core/curve_export.h"
 #include "core/dataset_io.h"
 #include "core/errors.h"
@@ -951,7 +952,11 @@ std::vector<Pose3> RunCommand::frontendPoses(const RunInput& input) const {
 
 RunInput RunCommand::loadInput() const {
   RunInput input;
-  input.sequence = loadImageSequence(dataset_dir_, sequence_);
+  std::optional<FallbackCamera> model_camera;
+  if (!init_poses_path_.empty() && fs::is_directory(init_poses_path_)) {
+    model_camera = colmapModelCamera(init_poses_path_);
+  }
+  input.sequence = loadImageSequence(dataset_dir_, sequence_, model_camera);
   const std::vector<StampedPose> poses =
       readInitialPoses(init_poses_path_, input.sequence, &input.init_poses_source);
   if (!poses.empty()) {

@@ -298,6 +298,12 @@ ColmapModel readColmapModel(const std::string& dir) {
   return model;
 }
 
+std::optional<FallbackCamera> colmapModelCamera(const std::string& dir) {
+  const ColmapModel model = readColmapModel(dir);
+  if (model.cameras.size() != 1) return std::nullopt;
+  return FallbackCamera{model.cameras.begin()->second, "the COLMAP model " + dir};
+}
+
 std::vector<StampedPose> colmapPosesForSequence(const ColmapModel& model,
                                                 const ImageSequence& sequence) {
   std::map<std::string, const ColmapImage*> by_name;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,10 @@ struct ColmapModel {
 /// offset in the message) for malformed content, an unknown or unsupported camera model, or an
 /// image whose camera_id is not in the cameras file.
 ColmapModel readColmapModel(const std::string& dir);
+
+/// The camera of the COLMAP model in `dir`, when it has exactly one (a sequence's intrinsics);
+/// nothing when it has several. Throws as readColmapModel().
+std::optional<FallbackCamera> colmapModelCamera(const std::string& dir);
 
 /// The model's poses of `sequence`'s images as camera-to-world StampedPose (the images'
 /// timestamps), in the sequence's order: an image matches the model image of the same name

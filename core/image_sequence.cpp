@@ -763,7 +763,8 @@ void checkImageFile(const std::string& path) {
 }
 
 Camera resolveCamera(const LayoutContents& c, const ImageSequenceOptions& options,
-                     const std::string& first_image, std::string* source) {
+                     const std::optional<FallbackCamera>& fallback, const std::string& first_image,
+                     std::string* source) {
   const auto first_image_size = [&] {
     const cv::Mat image = readColorImage(first_image);
     return std::make_pair(image.cols, image.rows);
@@ -773,10 +774,21 @@ Camera resolveCamera(const LayoutContents& c, const ImageSequenceOptions& option
     *source = "--camera";
     return parseCameraString(options.camera, width, height);
   }
+  if (!c.intrinsics && fallback) {
+    const auto [width, height] = first_image_size();
+    if (width != fallback->camera.width() || height != fallback->camera.height()) {
+      throw IoError(first_image, "is " + std::to_string(width) + "x" + std::to_string(height) +
+                                     " px, the camera of " + fallback->source + " " +
+                                     std::to_string(fallback->camera.width()) + "x" +
+                                     std::to_string(fallback->camera.height()));
+    }
+    *source = fallback->source;
+    return fallback->camera;
+  }
   if (!c.intrinsics) {
     throw IoError(c.camera_looked_for,
                   std::string("no such file, so the dataset gives no intrinsics: pass --camera ") +
-                      kCameraFormat + " (pixels)");
+                      kCameraFormat + " (pixels), or a COLMAP model as initial poses");
   }
   CameraIntrinsics intrinsics = *c.intrinsics;
   if (intrinsics.width == 0) std::tie(intrinsics.width, intrinsics.height) = first_image_size();
@@ -856,7 +868,8 @@ DatasetLayout detectDatasetLayout(const std::string& dir) {
   throw IoError(dir, "no known dataset layout: looked for " + looked_for + hint);
 }
 
-ImageSequence loadImageSequence(const std::string& dir, const ImageSequenceOptions& options) {
+ImageSequence loadImageSequence(const std::string& dir, const ImageSequenceOptions& options,
+                                const std::optional<FallbackCamera>& fallback) {
   options.validate();
   const DatasetLayout layout =
       options.layout == DatasetLayout::kAuto ? detectDatasetLayout(dir) : options.layout;
@@ -898,7 +911,7 @@ ImageSequence loadImageSequence(const std::string& dir, const ImageSequenceOptio
   ImageSequence s;
   s.dir = dir;
   s.layout = toString(layout);
-  s.camera = resolveCamera(c, options, selected.front().image_path, &s.camera_source);
+  s.camera = resolveCamera(c, options, fallback, selected.front().image_path, &s.camera_source);
   s.ground_truth = c.ground_truth;
   s.ground_truth_source = c.ground_truth_source;
   for (const LayoutFrame& frame : selected) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -84,11 +85,21 @@ struct ImageSequence {
   std::string ground_truth_source;  ///< The file(s) it came from; empty without ground truth.
 };
 
+/// Intrinsics for a sequence whose dataset gives none and for which no --camera was given: the
+/// camera of a COLMAP model given as initial poses.
+struct FallbackCamera {
+  Camera camera;
+  std::string source;  ///< Where it came from (ImageSequence::camera_source).
+};
+
 /// Reads the sequence in `dir`: the image list, the camera, the ground truth if present. Every
 /// file but the images is parsed and every selected image checked to exist and be in a format
 /// OpenCV reads (the first one is decoded for its size where the layout does not give it), so
-/// that bad input fails before any work. Throws as the comment at the top of this file says.
-ImageSequence loadImageSequence(const std::string& dir, const ImageSequenceOptions& options);
+/// that bad input fails before any work. The camera is options.camera's, else the dataset's,
+/// else `fallback`'s (whose size must be the first image's). Throws as the comment at the top of
+/// this file says.
+ImageSequence loadImageSequence(const std::string& dir, const ImageSequenceOptions& options,
+                                const std::optional<FallbackCamera>& fallback = std::nullopt);
 
 /// The layout of `dir` from the files present: rgb.txt -> tum; calib.txt or image_0/ -> kitti;
 /// *_par.txt -> middlebury; *.camera (in dir or gt_dense_cameras/) -> strecha; cameras/ or txt/

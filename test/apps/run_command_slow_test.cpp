@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -302,6 +303,41 @@ TEST_F(RunCommandTest, FitChecksDropCurvesThatDoNotFitTheirViews) {
                                        "0 along their epipolar planes)"));
   EXPECT_THAT(result.output, HasSubstr(", residual above the bound, dropped after 1 global BA"));
   EXPECT_THAT(result.output, HasSubstr("were implausible (outside the scene's extent"));
+}
+
+// What a user of COLMAP has: a bare folder of images and the model COLMAP made of them.
+TEST_F(RunCommandTest, APlainImageFolderTakesPosesAndCameraFromACOLMAPModel) {
+  const std::string dataset = writeShortPlanarDataset();
+  const std::string images = path("plain"), model = path("model");
+  std::filesystem::create_directories(images);
+  std::filesystem::create_directories(model);
+  // COLMAP's pixel centres are at +0.5: the planar camera's 119.5, 89.5 is its 120, 90.
+  std::ofstream(model + "/cameras.txt") << "1 PINHOLE 240 180 200 200 120 90\n";
+  std::ofstream images_txt(model + "/images.txt");
+  const std::vector<ImageEntry> entries = readImageList(dataset + "/rgb.txt");
+  const std::vector<StampedPose> poses = readTrajectory(dataset + "/init_poses.txt");
+  ASSERT_EQ(entries.size(), poses.size());
+  images_txt << std::setprecision(17);
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const std::string name = "view" + std::to_string(i) + ".png";
+    std::filesystem::copy_file(entries[i].path, images + "/" + name);
+    const Pose3 cam_from_world = poses[i].world_from_cam.inverse();
+    const Eigen::Quaterniond& q = cam_from_world.rotation();
+    const Eigen::Vector3d& t = cam_from_world.translation();
+    images_txt << i + 1 << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " "
+               << t.x() << " " << t.y() << " " << t.z() << " 1 " << name << "\n\n";
+  }
+  images_txt.close();
+  const RunWithReport run = runWithReport(
+      "run --dataset " + images + " --init-poses " + model + shortPlanarFlags(), path("out"));
+  EXPECT_THAT(run.result.output, HasSubstr(images +
+                                           " (images layout), 6 of 6 images with an "
+                                           "initial pose (" +
+                                           model + ")"));
+  EXPECT_EQ(run.report["dataset"]["layout"], "images");
+  EXPECT_EQ(run.report["dataset"]["camera"], "the COLMAP model " + model);
+  EXPECT_EQ(run.report["camera"]["cx"], 119.5);
+  EXPECT_EQ(run.report["counts"]["keyframes"], 6);
 }
 
 }  // namespace

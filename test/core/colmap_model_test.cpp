@@ -155,5 +155,16 @@ TEST_F(ColmapModelTest, PosesForASequenceMatchByNameThenFileName) {
               ThrowsMessage<ParseError>(AllOf(HasSubstr(dir_.string()), HasSubstr("z.png"))));
 }
 
+TEST_F(ColmapModelTest, TheCameraOfAOneCameraModelIsASequencesCamera) {
+  writeText("1 PINHOLE 64 48 50 51 32 24\n");
+  const std::optional<FallbackCamera> camera = colmapModelCamera(dir_.string());
+  ASSERT_TRUE(camera.has_value());
+  EXPECT_EQ(camera->camera.fy(), 51.0);
+  EXPECT_EQ(camera->camera.cx(), 31.5);
+  EXPECT_THAT(camera->source, HasSubstr(dir_.string()));
+  writeText("1 PINHOLE 64 48 50 51 32 24\n2 PINHOLE 64 48 60 61 32 24\n");
+  EXPECT_FALSE(colmapModelCamera(dir_.string()).has_value());
+}
+
 }  // namespace
 }  // namespace curvesfm

@@ -489,5 +489,30 @@ TEST_F(ImageSequenceTest, AFolderWithoutImagesSaysWhereItLooked) {
                   AllOf(HasSubstr(dir_.string() + ": holds no images"), HasSubstr(".png, .jpg"))));
 }
 
+TEST_F(ImageSequenceTest, AFallbackCameraServesOnlyADatasetWithoutIntrinsics) {
+  image("a.png", 8, 6);
+  CameraIntrinsics k;
+  k.fx = k.fy = 7.0;
+  k.width = 8;
+  k.height = 6;
+  const FallbackCamera fallback{Camera(k), "the COLMAP model M"};
+  const ImageSequence s = loadImageSequence(dir_.string(), {}, fallback);
+  EXPECT_EQ(s.camera.fx(), 7.0);
+  EXPECT_EQ(s.camera_source, "the COLMAP model M");
+  ImageSequenceOptions options;
+  options.camera = "10,10,3,2";
+  EXPECT_EQ(loadImageSequence(dir_.string(), options, fallback).camera.fx(), 10.0);
+  k.fx = 9.0;
+  writeCameraYaml(path("camera.yaml"), Camera(k));
+  EXPECT_EQ(loadImageSequence(dir_.string(), {}, fallback).camera.fx(), 9.0);
+  fs::remove(path("camera.yaml"));
+  k.width = 16;
+  EXPECT_THAT(
+      [&] {
+        loadImageSequence(dir_.string(), {}, FallbackCamera{Camera(k), "M"});
+      },
+      ThrowsMessage<IoError>(HasSubstr(path("a.png") + ": is 8x6 px, the camera of M 16x6")));
+}
+
 }  // namespace
 }  // namespace curvesfm

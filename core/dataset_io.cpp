@@ -158,10 +158,12 @@ struct YamlFile {
     return static_cast<int>(value);
   }
 
-  // The numbers of a matrix key as OpenCV writes it (!!opencv-matrix) or ROS camera_info does
-  // ({rows, cols, data}): its data in row order; `counts` lists the accepted sizes.
+  // The numbers of a key that is a sequence, or a matrix as OpenCV writes it (!!opencv-matrix)
+  // or ROS camera_info does ({rows, cols, data}): its data in row order; `counts` lists the
+  // accepted sizes.
   std::vector<double> matrixData(const std::string& key, std::initializer_list<int> counts) const {
-    const cv::FileNode data = storage[key]["data"];
+    const cv::FileNode node = storage[key];
+    const cv::FileNode data = node.isMap() ? node["data"] : node;
     std::string sizes;
     for (const int count : counts) sizes += (sizes.empty() ? "" : " or ") + std::to_string(count);
     const std::string expected = "key " + key + " (a matrix of " + sizes + " numbers: data)";
@@ -189,7 +191,8 @@ CameraIntrinsics orbSlamIntrinsics(const YamlFile& file) {
   if (file.storage["Camera.fx"].isNone()) {
     throw ParseError(file.path, 0,
                      "key Camera.fx (a number; or camera_matrix, image_width and image_height as "
-                     "OpenCV's calibration and ROS camera_info write them)",
+                     "OpenCV's calibration and ROS camera_info write them; or intrinsics and "
+                     "resolution as EuRoC's sensor.yaml)",
                      "no such key");
   }
   CameraIntrinsics intrinsics;
@@ -248,24 +251,72 @@ std::array<double, 5> calibrationDistortion(const YamlFile& file) {
   return k1_k2_p1_p2_k3;
 }
 
+// A pinhole camera with radial-tangential distortion from its parameters.
+CameraIntrinsics pinholeIntrinsics(const std::array<double, 4>& fx_fy_cx_cy,
+                                   const std::array<double, 5>& k1_k2_p1_p2_k3, int width,
+                                   int height) {
+  CameraIntrinsics intrinsics;
+  intrinsics.fx = fx_fy_cx_cy[0];
+  intrinsics.fy = fx_fy_cx_cy[1];
+  intrinsics.cx = fx_fy_cx_cy[2];
+  intrinsics.cy = fx_fy_cx_cy[3];
+  intrinsics.k1 = k1_k2_p1_p2_k3[0];
+  intrinsics.k2 = k1_k2_p1_p2_k3[1];
+  intrinsics.p1 = k1_k2_p1_p2_k3[2];
+  intrinsics.p2 = k1_k2_p1_p2_k3[3];
+  intrinsics.k3 = k1_k2_p1_p2_k3[4];
+  intrinsics.width = width;
+  intrinsics.height = height;
+  return intrinsics;
+}
+
+// EuRoC's camera_model and distortion_model, where given, must be ours.
+void checkEurocModels(const YamlFile& file) {
+  for (const auto& [key, allowed] :
+       {std::pair<const char*, std::vector<std::string>>{"camera_model", {"pinhole"}},
+        {"distortion_model", {"radial-tangential", "radtan", "plumb_bob", "none"}}}) {
+    const cv::FileNode node = file.storage[key];
+    if (node.isNone()) continue;
+    const std::string value = node.isString() ? node.string() : describeNode(node);
+    if (std::find(allowed.begin(), allowed.end(), value) == allowed.end()) {
+      throw ParseError(file.path, lineOfKey(file.text, key),
+                       std::string("key ") + key + " " + allowed.front() +
+                           " (the camera model is a pinhole with radial-tangential distortion)",
+                       quoteToken(value));
+    }
+  }
+}
+
+// What EuRoC's sensor.yaml (and a Kalibr camera) holds: intrinsics [fu fv cu cv], resolution
+// [width height], distortion_coefficients [k1 k2 p1 p2] of the radial-tangential model.
+CameraIntrinsics eurocIntrinsics(const YamlFile& file) {
+  checkEurocModels(file);
+  const std::vector<double> k = file.matrixData("intrinsics", {4});
+  const std::vector<double> size = file.matrixData("resolution", {2});
+  std::array<double, 5> d{};
+  if (!file.storage["distortion_coefficients"].isNone()) {
+    const std::vector<double> given = file.matrixData("distortion_coefficients", {0, 4, 5});
+    std::copy(given.begin(), given.end(), d.begin());
+  }
+  if (!(k[0] > 0.0 && k[1] > 0.0) || size[0] < 1.0 || size[1] < 1.0 ||
+      size[0] != std::floor(size[0]) || size[1] != std::floor(size[1])) {
+    throw ParseError(file.path, lineOfKey(file.text, "intrinsics"),
+                     "intrinsics with fu, fv > 0 and a resolution of whole pixels",
+                     "fu " + formatNumber(k[0]) + ", fv " + formatNumber(k[1]) + ", resolution " +
+                         formatNumber(size[0]) + " x " + formatNumber(size[1]));
+  }
+  return pinholeIntrinsics({k[0], k[1], k[2], k[3]}, d, static_cast<int>(size[0]),
+                           static_cast<int>(size[1]));
+}
+
 // What OpenCV's calibration sample and ROS camera_info write: camera_matrix,
 // distortion_coefficients (optional), image_width, image_height.
 CameraIntrinsics calibrationIntrinsics(const YamlFile& file) {
+  // One after the other, so that the first problem in the file is the one reported.
   const std::array<double, 4> K = calibrationMatrix(file);
   const std::array<double, 5> d = calibrationDistortion(file);
-  CameraIntrinsics intrinsics;
-  intrinsics.fx = K[0];
-  intrinsics.fy = K[1];
-  intrinsics.cx = K[2];
-  intrinsics.cy = K[3];
-  intrinsics.k1 = d[0];
-  intrinsics.k2 = d[1];
-  intrinsics.p1 = d[2];
-  intrinsics.p2 = d[3];
-  intrinsics.k3 = d[4];
-  intrinsics.width = file.pixelCount("image_width");
-  intrinsics.height = file.pixelCount("image_height");
-  return intrinsics;
+  const int width = file.pixelCount("image_width");
+  return pinholeIntrinsics(K, d, width, file.pixelCount("image_height"));
 }
 
 }  // namespace
@@ -382,9 +433,24 @@ Camera readCameraYaml(const std::string& path) {
     throw ParseError(path, 0, "a YAML mapping of Camera.* keys", describeNode(root));
   }
   const YamlFile file{path, text, storage};
-  const bool calibration_form =
-      !root.isNone() && !storage["camera_matrix"].isNone() && storage["Camera.fx"].isNone();
-  return Camera(calibration_form ? calibrationIntrinsics(file) : orbSlamIntrinsics(file));
+  const auto has = [&](const char* key) { return !root.isNone() && !storage[key].isNone(); };
+  if (!has("Camera.fx") && has("camera_matrix")) return Camera(calibrationIntrinsics(file));
+  if (!has("Camera.fx") && has("intrinsics")) return Camera(eurocIntrinsics(file));
+  return Camera(orbSlamIntrinsics(file));
+}
+
+std::vector<double> readYamlNumbers(const std::string& path, const std::string& key) {
+  const std::string text = readWholeFile(path);
+  cv::FileStorage storage;
+  openYaml(path, text, &storage);
+  const cv::FileNode root = storage.root();
+  if (!root.isMap() || storage[key].isNone()) {
+    throw ParseError(path, 0, "key " + key + " (numbers)", "no such key");
+  }
+  const cv::FileNode node = storage[key];
+  const cv::FileNode data = node.isMap() ? node["data"] : node;
+  const YamlFile file{path, text, storage};
+  return file.matrixData(key, {data.isSeq() ? static_cast<int>(data.size()) : 0});
 }
 
 void writeCameraYaml(const std::string& path, const Camera& camera) {

@@ -82,11 +82,19 @@ std::vector<StampedPose> stampedPoses(const std::vector<double>& timestamps,
 ///    camera_matrix (3x3, as !!opencv-matrix or {rows, cols, data}; zero skew), image_width,
 ///    image_height; optional distortion_coefficients (k1 k2 p1 p2 [k3], or OpenCV's 8, 12 or 14
 ///    with every coefficient after k3 zero) and distortion_model (plumb_bob).
+///  - EuRoC's sensor.yaml (when there is neither): intrinsics [fu, fv, cu, cv], resolution
+///    [width, height], optional distortion_coefficients [k1, k2, p1, p2], distortion_model
+///    radial-tangential and camera_model pinhole.
 /// Other keys are ignored. The "%YAML:1.0" / "%YAML 1.0" header is optional.
 /// Errors: IoError if the file cannot be read; ParseError for YAML that OpenCV rejects (with the
 /// line OpenCV reports and its message), for a missing required key (line 0), and for a value
 /// that is not a finite number or out of range (with the key's line when it can be located).
 Camera readCameraYaml(const std::string& path);
+
+/// The numbers of `key` in an OpenCV FileStorage YAML file, a sequence or a matrix
+/// ({rows, cols, data} or !!opencv-matrix, in row order). ParseError naming the file (and the
+/// key's line) when the key is absent or holds anything else.
+std::vector<double> readYamlNumbers(const std::string& path, const std::string& key);
 
 /// Writes `camera` as OpenCV FileStorage YAML ("%YAML:1.0" header) with every key that
 /// readCameraYaml() reads, distortion included; numbers with 17 significant digits, so that

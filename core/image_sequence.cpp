@@ -121,7 +121,7 @@ struct LayoutContents {
   std::optional<CameraIntrinsics> intrinsics;  ///< width/height 0: take the first image's.
   std::string camera_source;                   ///< The file the intrinsics came from.
   std::string camera_looked_for;               ///< Without intrinsics: what was looked for.
-  std::vector<StampedPose> ground_truth;       ///< TUM and images; the others use frames.
+  std::vector<StampedPose> ground_truth;       ///< TUM, EuRoC, images; the others use frames.
   std::string ground_truth_source;
 };
 
@@ -674,6 +674,97 @@ LayoutContents readSevenScenes(const fs::path& dir) {
   return c;
 }
 
+// --- EuRoC MAV -----------------------------------------------------------------------------------
+
+constexpr const char* kEurocGroundTruthFields[] = {
+    "timestamp [ns]", "p_RS_R_x", "p_RS_R_y", "p_RS_R_z", "q_RS_w", "q_RS_x", "q_RS_y", "q_RS_z"};
+
+// The camera folder of a EuRoC sequence given as its root (mav0/cam0 below it), as mav0, or as
+// the camera folder itself: the one holding data.csv and sensor.yaml.
+std::optional<fs::path> eurocCameraFolder(const fs::path& dir) {
+  for (const fs::path& folder : {dir / "mav0" / "cam0", dir / "cam0", dir}) {
+    if (isFile(folder / "data.csv") && isFile(folder / "sensor.yaml")) {
+      const fs::path normal = fs::absolute(folder).lexically_normal();
+      return normal.has_filename() ? normal : normal.parent_path();
+    }
+  }
+  return std::nullopt;
+}
+
+// sensor.yaml's T_BS: the camera's pose in the body (IMU) frame, x_body = T_BS x_cam.
+Pose3 eurocBodyFromCamera(const std::string& sensor_yaml) {
+  const std::vector<double> T = readYamlNumbers(sensor_yaml, "T_BS");
+  if (T.size() != 16) {
+    throw ParseError(sensor_yaml, 0, "key T_BS (a 4x4 matrix, 16 numbers)",
+                     std::to_string(T.size()) + " numbers");
+  }
+  const Eigen::Matrix4d M =
+      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(T.data());
+  const Eigen::Matrix3d R =
+      checkedRotation(M.topLeftCorner<3, 3>(), sensor_yaml, 0, "T_BS's 3x3 block");
+  return Pose3(R, M.topRightCorner<3, 1>());
+}
+
+// state_groundtruth_estimate0/data.csv: per line the body's pose in the world (timestamp [ns],
+// p_RS_R, q_RS as w x y z, then velocities and biases), carried to the camera by T_BS.
+std::vector<StampedPose> readEurocGroundTruth(const std::string& path, const Pose3& body_from_cam) {
+  std::vector<StampedPose> poses;
+  forEachRecord(
+      path,
+      [&](int line, const TextFields& fields) {
+        if (fields.size() < 8) {
+          requireFieldCount(path, line, fields, 8,
+                            "timestamp [ns], p_RS_R (3), q_RS (w x y z), ...");
+        }
+        double v[8];
+        for (std::size_t i = 0; i < 8; ++i) {
+          v[i] = numberField(path, line, fields, i, kEurocGroundTruthFields[i]);
+        }
+        const Eigen::Quaterniond q(v[4], v[5], v[6], v[7]);
+        if (!(std::abs(q.norm() - 1.0) <= kQuaternionNormTolerance)) {
+          throw ParseError(path, line, "a unit quaternion q_RS (w x y z)",
+                           "norm " + formatNumber(q.norm()));
+        }
+        const Pose3 world_from_body(q.normalized(), Eigen::Vector3d(v[1], v[2], v[3]));
+        poses.push_back({v[0] * 1e-9, world_from_body * body_from_cam});
+      },
+      kCsvSeparators);
+  if (poses.empty()) throw ParseError(path, 0, "at least one pose line", "none");
+  return poses;
+}
+
+// EuRoC MAV: cam0/data.csv ("timestamp [ns],filename") lists the images in cam0/data/,
+// cam0/sensor.yaml holds the camera and T_BS, and mav0/state_groundtruth_estimate0/data.csv, if
+// present, the body's poses.
+LayoutContents readEuroc(const fs::path& dir) {
+  const std::optional<fs::path> camera = eurocCameraFolder(dir);
+  if (!camera) {
+    throw IoError(dir.string(),
+                  "no EuRoC camera folder: looked for data.csv and sensor.yaml in mav0/cam0/, "
+                  "cam0/ and the folder itself");
+  }
+  LayoutContents c;
+  const std::string sensor = (*camera / "sensor.yaml").string();
+  c.intrinsics = readCameraYaml(sensor).intrinsics();
+  c.camera_source = sensor;
+  const std::string list = (*camera / "data.csv").string();
+  forEachRecord(
+      list,
+      [&](int line, const TextFields& fields) {
+        requireFieldCount(list, line, fields, 2, "timestamp [ns],filename");
+        const double timestamp = numberField(list, line, fields, 0, "timestamp [ns]") * 1e-9;
+        c.frames.push_back(
+            {timestamp, joinPath(*camera / "data", std::string(fields[1])), std::nullopt});
+      },
+      kCsvSeparators);
+  const fs::path ground_truth = camera->parent_path() / "state_groundtruth_estimate0" / "data.csv";
+  if (isFile(ground_truth)) {
+    c.ground_truth = readEurocGroundTruth(ground_truth.string(), eurocBodyFromCamera(sensor));
+    c.ground_truth_source = ground_truth.string();
+  }
+  return c;
+}
+
 // --- A plain folder of images -------------------------------------------------------------------
 
 // The images directly in `dir`, or in dir/images/ (or its one sub-folder). Other layouts keep
@@ -738,6 +829,8 @@ const LayoutSignature kSignatures[] = {
      }},
     {DatasetLayout::kSevenScenes, "frame-*.pose.txt (7scenes)",
      [](const fs::path& d) { return hasAnyFile(d, isSevenScenesPose); }},
+    {DatasetLayout::kEuroc, "data.csv and sensor.yaml in mav0/cam0/, cam0/ or the folder (euroc)",
+     [](const fs::path& d) { return eurocCameraFolder(d).has_value(); }},
 };
 
 std::vector<DatasetLayout> matchingLayouts(const fs::path& dir) {
@@ -893,6 +986,9 @@ ImageSequence loadImageSequence(const std::string& dir, const ImageSequenceOptio
       break;
     case DatasetLayout::kSevenScenes:
       c = readSevenScenes(dir);
+      break;
+    case DatasetLayout::kEuroc:
+      c = readEuroc(dir);
       break;
     case DatasetLayout::kImages:
       c = readPlainImages(dir);

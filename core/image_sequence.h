@@ -29,12 +29,13 @@ enum class DatasetLayout {
   kProjection,   ///< Images with one 3x4 projection matrix file each (Pavilion, PMVS).
   kStrecha,      ///< Strecha / EPFL: images/*.jpg and gt_dense_cameras/*.camera.
   kSevenScenes,  ///< Microsoft 7-Scenes: frame-*.color.png|jpg and frame-*.pose.txt.
+  kEuroc,        ///< EuRoC MAV: mav0/cam0/data.csv, data/, sensor.yaml, the ground truth's csv.
   kImages,       ///< A plain folder of images (or its images/), camera.yaml or --camera.
 };
 
 template <>
 struct EnumNames<DatasetLayout> {
-  static constexpr std::array<std::pair<DatasetLayout, const char*>, 8> kNames = {
+  static constexpr std::array<std::pair<DatasetLayout, const char*>, 9> kNames = {
       {{DatasetLayout::kAuto, "auto"},
        {DatasetLayout::kTum, "tum"},
        {DatasetLayout::kKitti, "kitti"},
@@ -42,6 +43,7 @@ struct EnumNames<DatasetLayout> {
        {DatasetLayout::kProjection, "projection"},
        {DatasetLayout::kStrecha, "strecha"},
        {DatasetLayout::kSevenScenes, "7scenes"},
+       {DatasetLayout::kEuroc, "euroc"},
        {DatasetLayout::kImages, "images"}}};
 };
 
@@ -61,7 +63,8 @@ struct ImageSequenceOptions {
 
 /// One image of a sequence.
 struct SequenceImage {
-  /// Seconds. From the dataset where it has times (TUM rgb.txt, KITTI times.txt); otherwise the
+  /// Seconds. From the dataset where it has times (TUM rgb.txt, KITTI times.txt, EuRoC data.csv
+  /// in nanoseconds); otherwise the
   /// image's 0-based index in the dataset's own order before stride and max_frames, so that the
   /// images and ground truth of a subsampled sequence keep their times.
   double timestamp = 0.0;
@@ -77,10 +80,11 @@ struct ImageSequence {
   std::string camera_source;          ///< Where the intrinsics came from: a file, or "--camera".
   std::vector<SequenceImage> images;  ///< In the layout's order, after stride and max_frames.
   /// Camera-to-world poses (x_world = R x_cam + t, as TUM trajectories) in the dataset's own
-  /// world frame and unit (metres for TUM, KITTI, Middlebury, Strecha, 7-Scenes; Blender units
-  /// for Pavilion), stamped with the images' timestamps. TUM and images: the whole
-  /// groundtruth.txt; every other layout: one pose per entry of `images`, in the same order.
-  /// Empty without ground truth.
+  /// world frame and unit (metres for TUM, KITTI, Middlebury, Strecha, 7-Scenes, EuRoC; Blender
+  /// units for Pavilion), stamped with the images' timestamps. TUM and images: the whole
+  /// groundtruth.txt; EuRoC: the whole ground-truth csv, carried from the body to the camera;
+  /// every other layout: one pose per entry of `images`, in the same order. Empty without
+  /// ground truth.
   std::vector<StampedPose> ground_truth;
   std::string ground_truth_source;  ///< The file(s) it came from; empty without ground truth.
 };
@@ -103,7 +107,8 @@ ImageSequence loadImageSequence(const std::string& dir, const ImageSequenceOptio
 
 /// The layout of `dir` from the files present: rgb.txt -> tum; calib.txt or image_0/ -> kitti;
 /// *_par.txt -> middlebury; *.camera (in dir or gt_dense_cameras/) -> strecha; cameras/ or txt/
-/// of projection matrix files -> projection; frame-*.pose.txt -> 7scenes; and when none of
+/// of projection matrix files -> projection; frame-*.pose.txt -> 7scenes; data.csv and
+/// sensor.yaml in mav0/cam0/, cam0/ or dir -> euroc; and when none of
 /// these matches, image files in dir or in dir/images/ (or its one sub-folder) -> images. IoError
 /// naming the folder and listing the layouts looked for when none or several match (and the
 /// sub-folders that do match one, if any).

@@ -33,15 +33,14 @@ std::ifstream openForReading(const std::string& path) {
   return in;
 }
 
-TextFields splitFields(std::string_view line) {
-  // '\r' counts as a blank so that CRLF files parse like LF files.
-  constexpr std::string_view kBlanks = " \t\r\v\f";
+TextFields splitFields(std::string_view line, std::string_view separators) {
+  // '\r' is a separator so that CRLF files parse like LF files.
   TextFields fields;
-  std::size_t begin = line.find_first_not_of(kBlanks);
+  std::size_t begin = line.find_first_not_of(separators);
   while (begin != std::string_view::npos) {
-    const std::size_t end = std::min(line.find_first_of(kBlanks, begin), line.size());
+    const std::size_t end = std::min(line.find_first_of(separators, begin), line.size());
     fields.push_back(line.substr(begin, end - begin));
-    begin = line.find_first_not_of(kBlanks, end);
+    begin = line.find_first_not_of(separators, end);
   }
   return fields;
 }

@@ -23,16 +23,22 @@ using TextFields = std::vector<std::string_view>;
 /// which an ifstream would open and read as empty).
 std::ifstream openForReading(const std::string& path);
 
-/// The blank-separated fields of `line` ('\r' counts as a blank).
-TextFields splitFields(std::string_view line);
+/// What separates fields: blanks ('\r' counts as one), and for CSV files commas too (files
+/// without quoted fields, as EuRoC's data.csv).
+inline constexpr std::string_view kBlankSeparators = " \t\r\v\f";
+inline constexpr std::string_view kCsvSeparators = " \t\r\v\f,";
+/// The fields of `line`, split at runs of `separators`.
+TextFields splitFields(std::string_view line, std::string_view separators = kBlankSeparators);
 
 /// Removes a UTF-8 byte order mark from the start of `line`.
 std::string_view withoutByteOrderMark(std::string_view line);
 
 /// Calls visit(line_number, fields) for every line of `path` that is neither blank nor a comment,
-/// line numbers 1-based. IoError if the file cannot be opened or read.
+/// line numbers 1-based, fields split at `separators`. IoError if the file cannot be opened or
+/// read.
 template <class Visit>
-void forEachRecord(const std::string& path, Visit&& visit);
+void forEachRecord(const std::string& path, Visit&& visit,
+                   std::string_view separators = kBlankSeparators);
 
 /// The finite number `token` spells (a leading '+' allowed), or nothing.
 std::optional<double> parseFiniteNumber(std::string_view token);
@@ -54,7 +60,7 @@ double numberField(const std::string& path, int line, const TextFields& fields, 
                    const char* name);
 
 template <class Visit>
-void forEachRecord(const std::string& path, Visit&& visit) {
+void forEachRecord(const std::string& path, Visit&& visit, std::string_view separators) {
   std::ifstream in = openForReading(path);
   std::string line;
   int line_number = 0;
@@ -62,7 +68,7 @@ void forEachRecord(const std::string& path, Visit&& visit) {
     ++line_number;
     std::string_view view(line);
     if (line_number == 1) view = withoutByteOrderMark(view);
-    const TextFields fields = splitFields(view);
+    const TextFields fields = splitFields(view, separators);
     if (fields.empty() || fields.front().front() == '#') continue;
     visit(line_number, fields);
   }

@@ -288,8 +288,8 @@ TEST_F(DatasetIoTest, ReadCameraYamlWithoutFxIsParseError) {
   EXPECT_EQ(errorMessage<ParseError>([&] { readCameraYaml(path); }),
             "ParseError: " + path +
                 ": expected key Camera.fx (a number; or camera_matrix, image_width and "
-                "image_height as OpenCV's calibration and ROS camera_info write them), found no "
-                "such key");
+                "image_height as OpenCV's calibration and ROS camera_info write them; or "
+                "intrinsics and resolution as EuRoC's sensor.yaml), found no such key");
   const std::string empty = write("empty.yaml", "");
   EXPECT_THAT(errorMessage<ParseError>([&] { readCameraYaml(empty); }),
               HasSubstr(empty + ": expected key Camera.fx (a number; or camera_matrix"));

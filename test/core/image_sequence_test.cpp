@@ -514,5 +514,98 @@ TEST_F(ImageSequenceTest, AFallbackCameraServesOnlyADatasetWithoutIntrinsics) {
       ThrowsMessage<IoError>(HasSubstr(path("a.png") + ": is 8x6 px, the camera of M 16x6")));
 }
 
+// --- EuRoC MAV ---------------------------------------------------------------------------------
+
+// cam0's sensor.yaml as EuRoC publishes it (abridged), T_BS a turn of 90 degrees about z and a
+// shift.
+constexpr char kEurocSensor[] = R"(%YAML:1.0
+sensor_type: camera
+comment: VI-Sensor cam0 (MT9M034)
+
+# Sensor extrinsics wrt. the body-frame.
+T_BS:
+  cols: 4
+  rows: 4
+  data: [0.0, -1.0, 0.0, 0.1,
+         1.0, 0.0, 0.0, 0.2,
+         0.0, 0.0, 1.0, 0.3,
+         0.0, 0.0, 0.0, 1.0]
+
+# Camera specific definitions.
+rate_hz: 20
+resolution: [8, 6]
+camera_model: pinhole
+intrinsics: [458.654, 457.296, 367.215, 248.375] #fu, fv, cu, cv
+distortion_model: radial-tangential
+distortion_coefficients: [-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05]
+)";
+
+class EurocSequenceTest : public ImageSequenceTest {
+ protected:
+  void writeEuroc() const {
+    image("mav0/cam0/data/1403636579763555584.png");
+    image("mav0/cam0/data/1403636579813555456.png");
+    write("mav0/cam0/data.csv",
+          "#timestamp [ns],filename\r\n1403636579763555584,1403636579763555584.png\r\n"
+          "1403636579813555456,1403636579813555456.png\r\n");
+    write("mav0/cam0/sensor.yaml", kEurocSensor);
+    write("mav0/state_groundtruth_estimate0/data.csv",
+          "#timestamp, p_RS_R_x [m], p_RS_R_y [m], p_RS_R_z [m], q_RS_w [], q_RS_x [], q_RS_y [], "
+          "q_RS_z [], v_RS_R_x [m s^-1], v_RS_R_y, v_RS_R_z, b_w_x, b_w_y, b_w_z, b_a_x, b_a_y, "
+          "b_a_z\n"
+          "1403636579758555392,4.688319,-1.786938,0.783338,1,0,0,0,0,0,0,0,0,0,0,0,0\n"
+          "1403636579763555584,4.688177,-1.786770,0.787350,0,0,0,1,0,0,0,0,0,0,0,0,0\n");
+  }
+};
+
+TEST_F(EurocSequenceTest, ReadsCameraTimesAndTheCamerasGroundTruthFromAnyLevel) {
+  writeEuroc();
+  for (const std::string level : {"", "/mav0", "/mav0/cam0", "/mav0/cam0/"}) {
+    const ImageSequence s = loadImageSequence(dir_.string() + level, {});
+    EXPECT_EQ(s.layout, "euroc") << level;
+    ASSERT_EQ(s.images.size(), 2u) << level;
+    EXPECT_NEAR(s.images[1].timestamp, 1403636579.813555456, 1e-6) << level;
+    EXPECT_EQ(s.images[1].name, "1403636579813555456.png") << level;
+    EXPECT_EQ(s.camera.fx(), 458.654) << level;
+    EXPECT_EQ(s.camera.intrinsics().p2, 1.76187114e-05) << level;
+    EXPECT_EQ(s.camera.width(), 8) << level;
+    ASSERT_EQ(s.ground_truth.size(), 2u) << level;
+  }
+  const ImageSequence s = loadImageSequence(dir_.string(), {});
+  // The body turned 180 deg about z at (4.688177, -1.786770, 0.787350); the camera sits at
+  // T_BS's (0.1, 0.2, 0.3) in the body, so at that point minus (0.1, 0.2) in x and y, plus 0.3.
+  const Pose3& camera = s.ground_truth[1].world_from_cam;
+  expectPoseNear(camera,
+                 Pose3(Eigen::Matrix3d(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitZ())),
+                       Eigen::Vector3d(4.588177, -1.98677, 1.08735)));
+  EXPECT_NEAR(s.ground_truth[1].timestamp, 1403636579.763555584, 1e-6);
+}
+
+TEST_F(EurocSequenceTest, ABadGroundTruthLineOrExtrinsicsIsNamed) {
+  writeEuroc();
+  write("mav0/state_groundtruth_estimate0/data.csv", "#t\n1,0,0,0,2,0,0,0\n");
+  EXPECT_THAT([&] { load(); }, ThrowsMessage<ParseError>(
+                                   HasSubstr(path("mav0/state_groundtruth_estimate0/data.csv") +
+                                             ":2: expected a unit "
+                                             "quaternion q_RS (w x y z), found norm 2")));
+  write("mav0/state_groundtruth_estimate0/data.csv", "#t\n1,0,0,0,1,0,0\n");
+  EXPECT_THAT([&] { load(); }, ThrowsMessage<ParseError>(HasSubstr(":2: expected 8 fields")));
+  std::string sensor = kEurocSensor;
+  sensor.replace(sensor.find("0.0, -1.0, 0.0, 0.1"), 19, "0.0, -2.0, 0.0, 0.1");
+  write("mav0/cam0/sensor.yaml", sensor);
+  EXPECT_THAT([&] { load(); },
+              ThrowsMessage<ParseError>(AllOf(HasSubstr(path("mav0/cam0/sensor.yaml")),
+                                              HasSubstr("T_BS's 3x3 block to be a rotation"))));
+  sensor = kEurocSensor;
+  sensor.replace(sensor.find("radial-tangential"), 17, "equidistant");
+  write("mav0/cam0/sensor.yaml", sensor);
+  EXPECT_THAT([&] { load(); },
+              ThrowsMessage<ParseError>(HasSubstr(
+                  path("mav0/cam0/sensor.yaml") +
+                  ":19: expected key distortion_model "
+                  "radial-tangential (the camera model is a pinhole with radial-tangential "
+                  "distortion), found \"equidistant\"")));
+}
+
 }  // namespace
 }  // namespace curvesfm

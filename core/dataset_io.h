@@ -74,7 +74,7 @@ void writeTrajectory(const std::string& path, const std::vector<StampedPose>& po
 std::vector<StampedPose> stampedPoses(const std::vector<double>& timestamps,
                                       const std::vector<Pose3>& cam_from_world);
 
-/// Reads an OpenCV FileStorage YAML camera file in one of two forms:
+/// Reads an OpenCV FileStorage YAML camera file in one of three forms:
 ///  - ORB-SLAM2's keys. Required: Camera.fx, Camera.fy (> 0), Camera.cx, Camera.cy, Camera.width,
 ///    Camera.height (positive whole numbers); optional, default 0: Camera.k1, Camera.k2,
 ///    Camera.p1, Camera.p2, Camera.k3.

@@ -276,30 +276,42 @@ void readImagesBinary(const std::string& path, ColmapModel* model) {
 
 std::string baseName(const std::string& path) { return fs::path(path).filename().string(); }
 
+// The model's cameras, from cameras.txt or else cameras.bin; true when they were text.
+bool readCameras(const std::string& dir, ColmapModel* model) {
+  const fs::path folder(dir);
+  if (fs::exists(folder / "cameras.txt")) {
+    readCamerasText((folder / "cameras.txt").string(), model);
+    return true;
+  }
+  if (fs::exists(folder / "cameras.bin")) {
+    readCamerasBinary((folder / "cameras.bin").string(), model);
+    return false;
+  }
+  throw IoError(dir,
+                "no COLMAP model: looked for cameras.txt + images.txt and cameras.bin + "
+                "images.bin");
+}
+
 }  // namespace
 
 ColmapModel readColmapModel(const std::string& dir) {
   ColmapModel model;
   model.dir = dir;
   const fs::path folder(dir);
-  if (fs::exists(folder / "cameras.txt")) {
-    readCamerasText((folder / "cameras.txt").string(), &model);
+  if (readCameras(dir, &model)) {
     readImagesText((folder / "images.txt").string(), &model);
-  } else if (fs::exists(folder / "cameras.bin")) {
-    readCamerasBinary((folder / "cameras.bin").string(), &model);
+  } else {
     const std::string images = (folder / "images.bin").string();
     if (!fs::exists(images)) throw IoError(images, "no such file");
     readImagesBinary(images, &model);
-  } else {
-    throw IoError(dir,
-                  "no COLMAP model: looked for cameras.txt + images.txt and cameras.bin + "
-                  "images.bin");
   }
   return model;
 }
 
 std::optional<FallbackCamera> colmapModelCamera(const std::string& dir) {
-  const ColmapModel model = readColmapModel(dir);
+  // The cameras file alone: the images, which can be long, are read with the poses.
+  ColmapModel model;
+  readCameras(dir, &model);
   if (model.cameras.size() != 1) return std::nullopt;
   return FallbackCamera{model.cameras.begin()->second, "the COLMAP model " + dir};
 }

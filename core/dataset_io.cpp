@@ -160,13 +160,15 @@ struct YamlFile {
 
   // The numbers of a key that is a sequence, or a matrix as OpenCV writes it (!!opencv-matrix)
   // or ROS camera_info does ({rows, cols, data}): its data in row order; `counts` lists the
-  // accepted sizes.
+  // accepted sizes (empty: any).
   std::vector<double> matrixData(const std::string& key, std::initializer_list<int> counts) const {
     const cv::FileNode node = storage[key];
     const cv::FileNode data = node.isMap() ? node["data"] : node;
     std::string sizes;
     for (const int count : counts) sizes += (sizes.empty() ? "" : " or ") + std::to_string(count);
-    const std::string expected = "key " + key + " (a matrix of " + sizes + " numbers: data)";
+    const std::string expected = "key " + key + " (" +
+                                 (sizes.empty() ? "numbers" : "a matrix of " + sizes + " numbers") +
+                                 ": data)";
     const int line = lineOfKey(text, key);
     if (!data.isSeq()) throw ParseError(path, line, expected, describeNode(storage[key]));
     std::vector<double> values;
@@ -179,7 +181,8 @@ struct YamlFile {
       }
       values.push_back(value.real());
     }
-    if (std::find(counts.begin(), counts.end(), static_cast<int>(values.size())) == counts.end()) {
+    if (counts.size() > 0 &&
+        std::find(counts.begin(), counts.end(), static_cast<int>(values.size())) == counts.end()) {
       throw ParseError(path, line, expected, std::to_string(values.size()) + " numbers");
     }
     return values;
@@ -443,14 +446,10 @@ std::vector<double> readYamlNumbers(const std::string& path, const std::string& 
   const std::string text = readWholeFile(path);
   cv::FileStorage storage;
   openYaml(path, text, &storage);
-  const cv::FileNode root = storage.root();
-  if (!root.isMap() || storage[key].isNone()) {
+  if (!storage.root().isMap() || storage[key].isNone()) {
     throw ParseError(path, 0, "key " + key + " (numbers)", "no such key");
   }
-  const cv::FileNode node = storage[key];
-  const cv::FileNode data = node.isMap() ? node["data"] : node;
-  const YamlFile file{path, text, storage};
-  return file.matrixData(key, {data.isSeq() ? static_cast<int>(data.size()) : 0});
+  return YamlFile{path, text, storage}.matrixData(key, {});
 }
 
 void writeCameraYaml(const std::string& path, const Camera& camera) {

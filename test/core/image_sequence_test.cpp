@@ -590,6 +590,11 @@ TEST_F(EurocSequenceTest, ABadGroundTruthLineOrExtrinsicsIsNamed) {
                                              "quaternion q_RS (w x y z), found norm 2")));
   write("mav0/state_groundtruth_estimate0/data.csv", "#t\n1,0,0,0,1,0,0\n");
   EXPECT_THAT([&] { load(); }, ThrowsMessage<ParseError>(HasSubstr(":2: expected 8 fields")));
+  write("mav0/cam0/data.csv", "#timestamp [ns],filename\n1403636579763555584\n");
+  EXPECT_THAT([&] { load(); }, ThrowsMessage<ParseError>(HasSubstr(path("mav0/cam0/data.csv") +
+                                                                   ":2: expected 2 fields")));
+  writeEuroc();
+  write("mav0/state_groundtruth_estimate0/data.csv", "#t\n1,0,0,0,1,0,0,0\n");
   std::string sensor = kEurocSensor;
   sensor.replace(sensor.find("0.0, -1.0, 0.0, 0.1"), 19, "0.0, -2.0, 0.0, 0.1");
   write("mav0/cam0/sensor.yaml", sensor);

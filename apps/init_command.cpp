@@ -57,6 +57,9 @@ int InitCommand::run() const {
                        {"camera", sequence.camera_source},
                        {"images", sequence.images.size()},
                        {"groundtruth", sequence.ground_truth_source}};
+  // The camera the trajectory and points hold: the dataset's, its focal lengths refined with
+  // --points-ba-refine-focal.
+  report["camera"] = cameraToJson(sequence.camera.withFocalScale(result.focal_scale));
   report["ate"] = ate;
   report["total_seconds"] = secondsSince(start);
   writeJsonFile((fs::path(out_dir_) / "report.json").string(), report);

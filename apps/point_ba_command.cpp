@@ -69,6 +69,10 @@ int PointBaCommand::run() const {
   if (optimizer_.verbose) std::printf("%s\n", summary.full_report.c_str());
   printErrors("before:", before);
   printErrors("after:", after);
+  if (ba_.refine_focal) {
+    std::printf("focal lengths refined x%.6f (the scene's camera is exact: 1)\n",
+                extractFocalScale(problem.values));
+  }
 
   if (!report_path_.empty()) {
     const nlohmann::json report = {
@@ -83,6 +87,7 @@ int PointBaCommand::run() const {
         {"errors_before", errorsToJson(before)},
         {"errors_after", errorsToJson(after)},
         {"optimizer", summaryToJson(summary)},
+        {"focal_scale", extractFocalScale(problem.values)},
     };
     writeJsonFile(report_path_, report);
     std::printf("report: %s\n", report_path_.c_str());

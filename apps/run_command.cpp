@@ -510,12 +510,6 @@ nlohmann::json ateToJson(const AteResult& ate) {
           {"problem", ate.problem}};
 }
 
-// The pinhole camera of the undistorted keyframes (the report draws their frusta with it).
-nlohmann::json cameraToJson(const Camera& camera) {
-  return {{"width", camera.width()}, {"height", camera.height()}, {"fx", camera.fx()},
-          {"fy", camera.fy()},       {"cx", camera.cx()},         {"cy", camera.cy()}};
-}
-
 void writeConfigYaml(const std::string& path, const CLI::App& command) {
   std::ofstream out(path);
   if (!(out << "# curvesfm run: the options in force; rerun with --config " << path << "\n"
@@ -986,6 +980,8 @@ RunInput RunCommand::loadInput() const {
   input.init_poses_source = "initialiser";
   input.initialisation = initialiseSequence(input.sequence, initialiser_);
   printInitialisationSummary(input.sequence, *input.initialisation);
+  // The poses and points hold the camera the initialiser refined: so must the curves.
+  input.sequence.camera = input.sequence.camera.withFocalScale(input.initialisation->focal_scale);
   input.frames = initialisedFrames(input.sequence, *input.initialisation);
   input.sightings = initialisedSightings(*input.initialisation);
   return input;
@@ -1158,6 +1154,7 @@ nlohmann::json RunCommand::reportJson(const RunInput& input, const Outcome& outc
         {"frames_with_initial_pose", input.frames.size()}}},
       {"initialiser", input.initialisation ? initialisationToJson(d, *input.initialisation)
                                            : nlohmann::json(nullptr)},
+      // The pinhole camera of the undistorted keyframes (the report draws their frusta with it).
       {"camera", cameraToJson(outcome.pipeline->undistortedCamera())},
       {"start_model", startModelJson(outcome.start_model, outcome.tied_start, outcome.options.ba)},
       {"relift_passes_run", outcome.relift_passes},

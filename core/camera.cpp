@@ -86,6 +86,13 @@ bool Camera::hasDistortion() const {
   return c.k1 != 0.0 || c.k2 != 0.0 || c.p1 != 0.0 || c.p2 != 0.0 || c.k3 != 0.0;
 }
 
+Camera Camera::withFocalScale(double factor) const {
+  CameraIntrinsics scaled = intrinsics_;
+  scaled.fx *= factor;
+  scaled.fy *= factor;
+  return Camera(scaled);
+}
+
 Camera Camera::withoutDistortion() const {
   CameraIntrinsics pinhole = intrinsics_;
   pinhole.k1 = pinhole.k2 = pinhole.p1 = pinhole.p2 = pinhole.k3 = 0.0;

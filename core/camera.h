@@ -66,6 +66,8 @@ class Camera {
   bool hasDistortion() const;
   /// The same K and size without distortion: the camera of this one's undistorted images.
   Camera withoutDistortion() const;
+  /// The same camera with fx and fy multiplied by `factor` (> 0): a refined focal length.
+  Camera withFocalScale(double factor) const;
 
   /// Projects a point in the camera frame to a (distorted) pixel.
   /// H_point (optional, 2x3): d pixel / d point_in_cam, distortion included.

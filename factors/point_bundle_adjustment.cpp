@@ -26,6 +26,7 @@ PointBundleAdjustmentProblem buildPointBundleAdjustment(
   for (std::size_t p = 0; p < input.points.size(); ++p) {
     problem.values.insert(pointKey(p), input.points[p]);
   }
+  if (options.refine_focal) problem.values.insert(focalScaleKey(), 1.0);
 
   const NoiseModel pixel_noise{options.pixel_sigma,
                                RobustKernel(options.kernel, options.kernel_width)};
@@ -36,8 +37,15 @@ PointBundleAdjustmentProblem buildPointBundleAdjustment(
                    obs.point_index >= 0 && obs.point_index < num_points)
         << "observation of point " << obs.point_index << " in camera " << obs.camera_index
         << " is out of range (" << num_points << " points, " << num_cameras << " cameras)";
-    problem.graph.emplace<PointReprojectionFactor>(
-        poseKey(obs.camera_index), pointKey(obs.point_index), obs.pixel, input.camera, pixel_noise);
+    if (options.refine_focal) {
+      problem.graph.emplace<FocalPointReprojectionFactor>(
+          poseKey(obs.camera_index), pointKey(obs.point_index), focalScaleKey(), obs.pixel,
+          input.camera, pixel_noise);
+    } else {
+      problem.graph.emplace<PointReprojectionFactor>(poseKey(obs.camera_index),
+                                                     pointKey(obs.point_index), obs.pixel,
+                                                     input.camera, pixel_noise);
+    }
   }
 
   if (options.fix_first_pose && num_cameras > 0) problem.config.setConstant(poseKey(0));
@@ -53,6 +61,10 @@ std::vector<Eigen::Vector3d> extractPoints(const Values& values, std::size_t num
     points.push_back(values.at<Eigen::Vector3d>(pointKey(p)));
   }
   return points;
+}
+
+double extractFocalScale(const Values& values) {
+  return values.exists(focalScaleKey()) ? values.at<double>(focalScaleKey()) : 1.0;
 }
 
 }  // namespace curvesfm

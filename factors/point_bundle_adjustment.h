@@ -25,6 +25,10 @@ struct PointBundleAdjustmentOptions {
   /// PointBundleAdjustmentInput::scale_distance). Needs at least 2 cameras.
   bool fix_scale = true;
   double scale_sigma = 1e-4;  ///< Std dev of that distance constraint (scene units); > 0.
+  /// Refine the camera's focal lengths by one factor shared by all images (focalScaleKey(), a
+  /// FocalPointReprojectionFactor per observation; aspect ratio, principal point and distortion
+  /// held), for a camera whose focal length is known only roughly. Off: the camera as given.
+  bool refine_focal = false;
 
   void validate() const;
 };
@@ -47,12 +51,16 @@ struct PointBundleAdjustmentProblem {
   ProblemConfig config;
 };
 
-/// Builds one PointReprojectionFactor per observation plus the gauge. Throws CheckError for an
+/// Builds one PointReprojectionFactor per observation (FocalPointReprojectionFactor with
+/// options.refine_focal, the focal scale starting at 1) plus the gauge. Throws CheckError for an
 /// observation whose camera or point index is out of range.
 PointBundleAdjustmentProblem buildPointBundleAdjustment(
     const PointBundleAdjustmentInput& input, const PointBundleAdjustmentOptions& options);
 
 /// The points of `values`, in input order (extractPoses gives the poses).
 std::vector<Eigen::Vector3d> extractPoints(const Values& values, std::size_t num_points);
+
+/// The factor on the camera's focal lengths in `values` (1 when the problem did not refine it).
+double extractFocalScale(const Values& values);
 
 }  // namespace curvesfm

@@ -93,8 +93,11 @@ void CeresProblem::layOut(const std::vector<Key>& used,
       if (!constant) block.size += tangentDim(slot.type);
     } else {
       slot.block = static_cast<int>(blocks_.size());
+      // Intrinsics, which every image shares, stay in the reduced system beside the poses.
+      const VariableCategory category = categoryOf(key);
       blocks_.push_back(
-          {storage, ambientDim(slot.type), constant, categoryOf(key) == VariableCategory::kPose});
+          {storage, ambientDim(slot.type), constant,
+           category == VariableCategory::kPose || category == VariableCategory::kIntrinsics});
       storage += ambientDim(slot.type);
     }
     slots_.emplace(key, slot);

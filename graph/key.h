@@ -45,11 +45,20 @@ std::ostream& operator<<(std::ostream& os, Key key);
 
 /// What a variable is, read from its key's symbol. The scheduler fixes and frees variables by
 /// category, never by factor type.
-enum class VariableCategory { kPose, kPoint, kCurvePoint, kDirection, kLength, kOther };
+enum class VariableCategory {
+  kPose,
+  kPoint,
+  kCurvePoint,
+  kDirection,
+  kLength,
+  kIntrinsics,
+  kOther
+};
 
-/// Category of `key` by symbol: x pose, l point, q curve point, v direction, a/b lengths.
+/// Category of `key` by symbol: x pose, l point, q curve point, v direction, a/b lengths,
+/// f camera intrinsics.
 VariableCategory categoryOf(Key key);
-/// "pose", "point", "curve_point", "direction", "length", "other".
+/// "pose", "point", "curve_point", "direction", "length", "intrinsics", "other".
 std::string toString(VariableCategory category);
 
 /// Camera pose j (cam_from_world).
@@ -64,6 +73,8 @@ inline Key directionKey(std::uint32_t c, std::uint32_t i) { return Key('v', c, i
 inline Key startLengthKey(std::uint32_t c, std::uint32_t i) { return Key('a', c, i); }
 /// Length d2 of segment i of curve c (arm of the second inner control point).
 inline Key endLengthKey(std::uint32_t c, std::uint32_t i) { return Key('b', c, i); }
+/// The factor on the camera's focal lengths shared by every image (FocalPointReprojectionFactor).
+inline Key focalScaleKey() { return Key('f', 0); }
 
 /// The keys of the variables of segment i of curve c, which runs from Q_i to Q_{i+1}.
 struct SegmentKeys {

@@ -761,6 +761,16 @@ std::optional<OptimizationSummary> optimizeWithGraphSchur(const FactorGraph& gra
     *why_not = options.use_inner_iterations ? "inner iterations" : "the dogleg trust region";
     return std::nullopt;
   }
+  for (const auto& factor : graph) {
+    for (const Key key : factor->keys()) {
+      if (categoryOf(key) == VariableCategory::kIntrinsics && !config.isConstant(key)) {
+        // Its reduced system holds poses only, and as structure a variable that every
+        // observation shares would join all the structure into one group.
+        *why_not = "a free camera intrinsic";
+        return std::nullopt;
+      }
+    }
+  }
   const auto start = Clock::now();
   GraphSchurProblem problem(graph, *values, config);
   if (problem.reducedDimension() > kGraphSchurMaxReducedDimension) {

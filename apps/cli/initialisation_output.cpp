@@ -73,7 +73,34 @@ void trackSequence(const ImageSequence& sequence, PointInitialiser* initialiser,
   }
 }
 
+// Beyond this the refined focal length is more likely a weakly determined one than the
+// correction of a camera given roughly (7-Scenes' colour camera: 4 %).
+constexpr double kImplausibleFocalChange = 0.15;
+
+void printRefinedFocal(const Camera& given, double focal_scale) {
+  if (focal_scale == 1.0) return;
+  const Camera refined = given.withFocalScale(focal_scale);
+  std::printf(
+      "init: focal lengths refined x%.4f: fx %.2f, fy %.2f px (given %.2f, %.2f); the same "
+      "camera for another run: --camera %.6g,%.6g,%.6g,%.6g\n",
+      focal_scale, refined.fx(), refined.fy(), given.fx(), given.fy(), refined.fx(), refined.fy(),
+      refined.cx(), refined.cy());
+  if (std::abs(focal_scale - 1.0) > kImplausibleFocalChange) {
+    std::printf(
+        "init: warning: the refined focal length is %.0f %% off the one given: implausible for a "
+        "calibrated camera; check the camera, or run without --points-ba-refine-focal\n",
+        100.0 * std::abs(focal_scale - 1.0));
+  }
+}
+
 }  // namespace
+
+nlohmann::json cameraToJson(const Camera& camera) {
+  const CameraIntrinsics& c = camera.intrinsics();
+  return {{"width", c.width}, {"height", c.height}, {"fx", c.fx}, {"fy", c.fy},
+          {"cx", c.cx},       {"cy", c.cy},         {"k1", c.k1}, {"k2", c.k2},
+          {"p1", c.p1},       {"p2", c.p2},         {"k3", c.k3}};
+}
 
 PointInitialisation initialiseSequence(const ImageSequence& sequence,
                                        const PointInitialiserOptions& options) {
@@ -212,6 +239,7 @@ nlohmann::json initialisationToJson(const ImageSequence& sequence,
             {"merged_models", result.merged_models},
             {"pairs_tried", result.pairs_tried}}},
           {"scale_convention", result.scale_convention},
+          {"focal_scale", result.focal_scale},
           {"initial_pair",
            {{"frames", {result.initial_pair.first, result.initial_pair.second}},
             {"model", toString(g.model)},
@@ -255,6 +283,7 @@ nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
   for (const auto& [reason, list] : unregistered) {
     std::printf("init: not registered, %s: frames %s\n", reason.c_str(), frameRanges(list).c_str());
   }
+  printRefinedFocal(sequence.camera, result.focal_scale);
   const InitialiserTimes& t = result.seconds;
   std::printf(
       "init time: tracks %.2f s (KLT %.2f, descriptors %.2f; %.1f ms per frame, %.1f ms per "

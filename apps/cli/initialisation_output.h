@@ -51,6 +51,9 @@ std::vector<StampedPose> initialisedTrajectory(const ImageSequence& sequence,
 void writeInitialisedPoints(const std::string& path, const PointInitialisation& result,
                             const std::vector<Eigen::Vector3d>* refined_positions = nullptr);
 
+/// A camera's intrinsics and image size as report.json gives them.
+nlohmann::json cameraToJson(const Camera& camera);
+
 /// The report.json part of the initialiser: counts, the scale convention, the initial pair, per
 /// frame its registration (status, reason, correspondences, inliers), every BA's summary and the
 /// per-stage times.

@@ -387,7 +387,10 @@ void addPointBundleAdjustmentOptions(OptionsTable* table, PointBundleAdjustmentO
       .boolean("fix_scale", "fix-scale", &b->fix_scale,
                "Hold the distance between the first two cameras (scale gauge)")
       .number("scale_sigma", "scale-sigma", &b->scale_sigma,
-              "Std dev of that distance constraint (scene units)");
+              "Std dev of that distance constraint (scene units)")
+      .boolean("refine_focal", "refine-focal", &b->refine_focal,
+               "Refine the focal lengths, one factor for every image (the initialiser: in "
+               "global BA)");
 }
 
 void addSanityOptions(OptionsTable* table, SanityOptions* o, const OptionPlace& place) {

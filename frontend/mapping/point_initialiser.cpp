@@ -326,6 +326,7 @@ struct PointInitialiser::State {
     }
     const int held = static_cast<int>(cameras.size() - free.size());
     PointBundleAdjustmentOptions ba = options.ba;
+    ba.refine_focal = options.ba.refine_focal && scope == "global";
     // Two held frames fix all seven degrees of freedom; otherwise hold the reference frame and
     // the distance to the pair's second frame, as in two-view BA.
     const bool pair_in =
@@ -342,7 +343,10 @@ struct PointInitialiser::State {
         problem.config.setConstant(poseKey(i));
       }
     }
-    const OptimizerOptions& solver = scope == "local" ? options.local_ba : options.global_ba;
+    OptimizerOptions solver = scope == "local" ? options.local_ba : options.global_ba;
+    // graph_schur reduces to the poses alone, so Ceres takes a free focal length; it sums its
+    // threads' shares in the order they finish, and one thread keeps the result the same bits.
+    if (ba.refine_focal) solver.num_threads = 1;
     InitialiserBundleAdjustment report;
     report.scope = scope;
     report.model = model_id;
@@ -355,9 +359,16 @@ struct PointInitialiser::State {
     const std::vector<Eigen::Vector3d> positions = extractPoints(problem.values, points.size());
     for (std::size_t i = 0; i < points.size(); ++i)
       model->points[points[i]].position = positions[i];
+    if (ba.refine_focal) scaleFocalLengths(extractFocalScale(problem.values));
     report.summary.full_report.clear();  // Kept small: the report holds many solves.
     out.bundle_adjustments.push_back(std::move(report));
     (scope == "local" ? out.seconds.local_ba : out.seconds.global_ba) += secondsSince(start);
+  }
+
+  // Every later registration, triangulation and BA, and the result, see the refined camera.
+  void scaleFocalLengths(double factor) {
+    camera = std::make_shared<Camera>(camera->withFocalScale(factor));
+    out.focal_scale *= factor;
   }
 
   void globalRefinement(Model* model, int model_id) {

@@ -67,7 +67,9 @@ struct PointInitialiserOptions {
   FeatureTrackOptions tracks;        ///< When descriptors are matched and joined to KLT.
   TwoViewOptions two_view;           ///< The initial pair's geometry and acceptance.
   AbsolutePoseOptions registration;  ///< PnP registration of the next frames.
-  PointBundleAdjustmentOptions ba;   ///< Objective of every BA (pixel sigma, robust kernel).
+  /// Objective of every BA (pixel sigma, robust kernel). Its refine_focal applies to global BA
+  /// only: local BA sees too few images to tell the focal length from the depths.
+  PointBundleAdjustmentOptions ba;
   /// Solvers of local and global BA: our own Schur complement (graph_schur), as the curve BAs
   /// of `run`. Ceres' sparse_schur on two threads sums in an order the threads decide, so its
   /// poses differ in the 13th digit from run to run, enough to flip the curve pipeline's discrete
@@ -197,6 +199,9 @@ struct PointInitialisation {
   int pairs_tried = 0;                          ///< Pair candidates evaluated, all models.
   /// The gauge: map unit = median depth of the initial pair's points in its first frame.
   std::string scale_convention = "median depth of the initial pair's points = 1";
+  /// The factor global BA applied to the camera's focal lengths (unitless; 1 unless
+  /// ba.refine_focal): undistortedCamera() and the poses and points hold the refined camera.
+  double focal_scale = 1.0;
   std::vector<InitialiserBundleAdjustment> bundle_adjustments;
   std::vector<FeatureTrackFrameStats> track_stats;  ///< Per frame.
   InitialiserTimes seconds;
@@ -223,7 +228,8 @@ class PointInitialiser {
   /// graph (COLMAP's point_triangulator does the same for a known model). Every posed frame is
   /// "registered" with its pose unchanged. Call instead of finish(), once.
   PointInitialisation finishAtPoses(const std::vector<std::optional<Pose3>>& cam_from_world);
-  /// The pinhole camera of the undistorted images, which every result pixel refers to.
+  /// The pinhole camera of the undistorted images, which every result pixel refers to (after
+  /// finish(), with the focal lengths global BA refined under ba.refine_focal).
   const Camera& undistortedCamera() const;
   /// Called by finish() after every registered frame with (model, frames registered in it,
   /// frames given, live points in it): a long reconstruction shows its progress.

@@ -237,6 +237,17 @@ TEST(Camera, KAndDistortionFlagReflectIntrinsics) {
   EXPECT_TRUE(Camera(only_p2).hasDistortion());
 }
 
+TEST(Camera, WithFocalScaleScalesTheFocalLengthsOnly) {
+  const Camera camera(tumFreiburg1());
+  const Camera scaled = camera.withFocalScale(1.05);
+  EXPECT_DOUBLE_EQ(scaled.fx(), 1.05 * camera.fx());
+  EXPECT_DOUBLE_EQ(scaled.fy(), 1.05 * camera.fy());
+  EXPECT_EQ(scaled.cx(), camera.cx());
+  EXPECT_EQ(scaled.cy(), camera.cy());
+  EXPECT_EQ(scaled.intrinsics().k1, camera.intrinsics().k1);
+  EXPECT_EQ(scaled.width(), camera.width());
+}
+
 TEST(Camera, InvalidIntrinsicsThrowInvalidOptionsNamingField) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();

@@ -94,5 +94,39 @@ TEST(PointBundleAdjustment, RejectsOutOfRangeObservationsAndBadOptions) {
   EXPECT_THROW(bad.validate(), InvalidOptions);
 }
 
+// A camera whose focal lengths are 6 % too long: with the focal length free, BA finds the
+// true one (the scale factor 1 / 1.06) and the trajectory the true camera gives; held, the
+// wrong focal length bends the trajectory.
+TEST(PointBundleAdjustment, RefinesAFocalLengthGivenRoughly) {
+  PointSceneOptions options = smallScene(0.3);
+  options.arc_degrees = 120.0;
+  const PointScene scene = makePointScene(options);
+  CameraIntrinsics rough = scene.camera->intrinsics();
+  rough.fx *= 1.06;
+  rough.fy *= 1.06;
+  const auto solveWith = [&](bool refine_focal, double* focal_scale) {
+    PointBundleAdjustmentOptions ba;
+    ba.refine_focal = refine_focal;
+    PointBundleAdjustmentProblem problem = buildPointBundleAdjustment(
+        {std::make_shared<const Camera>(rough), scene.initial_cam_from_world, scene.initial_points,
+         scene.observations, scene.trueScaleDistance()},
+        ba);
+    const OptimizationSummary summary =
+        optimize(problem.graph, &problem.values, problem.config, OptimizerOptions());
+    EXPECT_TRUE(summary.usable) << summary.message;
+    *focal_scale = extractFocalScale(problem.values);
+    return evaluatePointScene(scene, extractPoses(problem.values, scene.true_cam_from_world.size()),
+                              extractPoints(problem.values, scene.true_points.size()));
+  };
+  double refined_scale = 0.0;
+  double held_scale = 0.0;
+  const PointSceneErrors refined = solveWith(true, &refined_scale);
+  const PointSceneErrors held = solveWith(false, &held_scale);
+  EXPECT_NEAR(refined_scale, 1.0 / 1.06, 0.003);
+  EXPECT_DOUBLE_EQ(held_scale, 1.0);
+  EXPECT_LT(refined.position_ate_sim3, 0.5 * held.position_ate_sim3);
+  EXPECT_LT(refined.reprojection_rmse_px, held.reprojection_rmse_px);
+}
+
 }  // namespace
 }  // namespace curvesfm

@@ -98,5 +98,56 @@ TEST(PointReprojectionFactor, PointBehindCameraGivesCappedErrorAndZeroJacobians)
   EXPECT_TRUE(factorAt({320, 240}).linearize(values).error.allFinite());
 }
 
+FocalPointReprojectionFactor focalFactorAt(const Eigen::Vector2d& measured) {
+  return FocalPointReprojectionFactor(poseKey(0), pointKey(0), focalScaleKey(), measured,
+                                      distortedCamera(), NoiseModel{});
+}
+
+Values withFocalScale(Values values, double scale) {
+  values.insert(focalScaleKey(), scale);
+  return values;
+}
+
+TEST(FocalPointReprojectionFactor, AtScaleOneIsThePlainFactor) {
+  std::mt19937 rng(4);
+  const Values values = randomConfiguration(rng);
+  const Eigen::VectorXd plain = factorAt({300, 200}).unwhitenedError(values);
+  const Eigen::VectorXd focal =
+      focalFactorAt({300, 200}).unwhitenedError(withFocalScale(values, 1.0));
+  EXPECT_LT((plain - focal).norm(), 1e-12);
+}
+
+TEST(FocalPointReprojectionFactor, IsTheCameraWithScaledFocalLengths) {
+  std::mt19937 rng(5);
+  const Values values = randomConfiguration(rng);
+  CameraIntrinsics scaled = distortedCamera()->intrinsics();
+  scaled.fx *= 1.07;
+  scaled.fy *= 1.07;
+  const PointReprojectionFactor reference(poseKey(0), pointKey(0), {300, 200},
+                                          std::make_shared<const Camera>(scaled), NoiseModel{});
+  const Eigen::VectorXd expected = reference.unwhitenedError(values);
+  const Eigen::VectorXd focal =
+      focalFactorAt({300, 200}).unwhitenedError(withFocalScale(values, 1.07));
+  EXPECT_LT((expected - focal).norm(), 1e-9);
+}
+
+TEST(FocalPointReprojectionFactor, JacobiansMatchNumericalAtRandomConfigurations) {
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> scale(0.8, 1.2);
+  for (int trial = 0; trial < 100; ++trial) {
+    const Values values = withFocalScale(randomConfiguration(rng), scale(rng));
+    testing::expectJacobiansMatchNumerical(focalFactorAt({300, 200}), values, 1e-5);
+  }
+}
+
+TEST(FocalPointReprojectionFactor, PointBehindCameraGivesCappedErrorAndZeroJacobians) {
+  Values values;
+  values.insert(poseKey(0), Pose3());
+  values.insert(pointKey(0), Eigen::Vector3d(0.1, 0.2, -1.0));
+  const Linearization linear = focalFactorAt({320, 240}).linearize(withFocalScale(values, 1.1));
+  EXPECT_DOUBLE_EQ(linear.error[0], PointReprojectionFactor::kBehindCameraError);
+  for (const Eigen::MatrixXd& jacobian : linear.jacobians) EXPECT_TRUE(jacobian.isZero());
+}
+
 }  // namespace
 }  // namespace curvesfm

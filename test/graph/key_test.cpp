@@ -48,6 +48,8 @@ TEST(Key, CategoryFollowsSymbol) {
   EXPECT_EQ(categoryOf(endLengthKey(1, 2)), VariableCategory::kLength);
   EXPECT_EQ(categoryOf(Key('z', 0)), VariableCategory::kOther);
   EXPECT_EQ(toString(VariableCategory::kCurvePoint), "curve_point");
+  EXPECT_EQ(categoryOf(focalScaleKey()), VariableCategory::kIntrinsics);
+  EXPECT_EQ(toString(VariableCategory::kIntrinsics), "intrinsics");
 }
 
 }  // namespace

@@ -954,6 +954,11 @@ RunInput RunCommand::loadInput() const {
   const std::vector<StampedPose> poses =
       readInitialPoses(init_poses_path_, input.sequence, &input.init_poses_source);
   if (!poses.empty()) {
+    if (initialiser_.ba.refine_focal) {
+      std::printf(
+          "run: note: --points-ba-refine-focal does nothing with given poses (they hold the "
+          "camera given; only the initialiser's own reconstruction refines it)\n");
+    }
     input.frames = framesWithPoses(input.sequence, poses, max_dt_, input.init_poses_source);
     if (!frontend_poses_path_.empty()) input.frontend_poses = frontendPoses(input);
     if (points_at_given_poses_ && input.frames.size() >= 2) {

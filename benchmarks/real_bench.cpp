@@ -5,7 +5,8 @@
 // some, or none), every photo of --planar-photos rendered by `curvesfm synth planar` as the set
 // planar_<name> (the paper's orbit over it, no initial poses), and every folder of --extra-sets
 // (any layout `curvesfm run` reads, with ground truth), and every variant of --variants:
-//   init    `curvesfm init --dataset SET --out ...`: the point initialiser alone;
+//   init    `curvesfm init --dataset SET --out ...` plus the flags of --init-flags: the point
+//           initialiser alone;
 //   curves  `curvesfm run --dataset SET --out ...`: with no initial poses, run starts with the
 //           point initialiser and refines its poses with the curve pipeline;
 //   hybrid  as curves plus the flags of --hybrid-flags (default `--ba-points true`: points and
@@ -133,6 +134,7 @@ struct BenchOptions {
   std::string planar_dir = bench::kOpenCvSampleData;  ///< Folder of --planar-photos.
   std::vector<std::string> variants = kVariantNames;  ///< Variants to run, in this order.
   std::string hybrid_flags = "--ba-points true";      ///< Extra flags of the hybrid variant.
+  std::string init_flags;                             ///< Extra flags of the init variant.
   int max_frames = 0;  ///< Frame cap for every set (0: each set's own cap).
   int stride = 0;      ///< Every stride-th image of every set (0: each set's own stride).
   int threads = 2;     ///< Threads for every solver flag curvesfm lists and for COLMAP.
@@ -941,7 +943,7 @@ std::vector<Variant> selectedVariants(const BenchOptions& options) {
   if (colmap_first) variants.push_back({"colmap", "", {}});
   for (const std::string& name : options.variants) {
     if (name == "colmap" && colmap_first) continue;
-    if (name == "init") variants.push_back({name, "init", {}});
+    if (name == "init") variants.push_back({name, "init", splitWords(options.init_flags)});
     if (name == "curves") variants.push_back({name, "run", {}});
     if (name == "hybrid") variants.push_back({name, "run", splitWords(options.hybrid_flags)});
     if (name == "colmap") variants.push_back({name, "", {}});
@@ -1310,6 +1312,10 @@ int main(int argc, char** argv) {
       ->default_str("init,curves,hybrid,colmap");
   app.add_option("--hybrid-flags", options.hybrid_flags,
                  "Flags the hybrid variant adds to `curvesfm run` (one string)")
+      ->capture_default_str();
+  app.add_option("--init-flags", options.init_flags,
+                 "Flags the init variant adds to `curvesfm init` (one string), e.g. "
+                 "\"--points-ba-refine-focal true\"")
       ->capture_default_str();
   app.add_option("--max-frames", options.max_frames,
                  "At most this many frames of every set (0: each set's own cap)")

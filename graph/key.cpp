@@ -43,8 +43,7 @@ VariableCategory categoryOf(Key key) {
     case 'v': return VariableCategory::kDirection;
     case 'a':
     case 'b': return VariableCategory::kLength;
-    case 'f':
-      return VariableCategory::kIntrinsics;
+    case 'f': return VariableCategory::kIntrinsics;
     default: return VariableCategory::kOther;
   }
 }
@@ -56,8 +55,7 @@ std::string toString(VariableCategory category) {
     case VariableCategory::kCurvePoint: return "curve_point";
     case VariableCategory::kDirection: return "direction";
     case VariableCategory::kLength: return "length";
-    case VariableCategory::kIntrinsics:
-      return "intrinsics";
+    case VariableCategory::kIntrinsics: return "intrinsics";
     case VariableCategory::kOther: break;
   }
   return "other";

@@ -140,6 +140,23 @@ TEST(FocalPointReprojectionFactor, JacobiansMatchNumericalAtRandomConfigurations
   }
 }
 
+TEST(FocalPointReprojectionFactor, CeresAdapterPassesGradientChecker) {
+  std::mt19937 rng(7);
+  const auto factor =
+      std::make_shared<const FocalPointReprojectionFactor>(focalFactorAt({310, 250}));
+  FactorCostFunction cost(factor);
+  const std::vector<const ceres::Manifold*> manifolds = {manifoldFor(VariableType::kPose3), nullptr,
+                                                         nullptr};
+  ceres::NumericDiffOptions numeric_options;
+  numeric_options.ridders_relative_initial_step_size = 1e-3;  // As the plain factor's check.
+  ceres::GradientChecker checker(&cost, &manifolds, numeric_options);
+  for (int trial = 0; trial < 20; ++trial) {
+    testing::expectProbeAgrees(
+        checker, testing::AmbientBlocks(*factor, withFocalScale(randomConfiguration(rng), 1.04)),
+        1e-6);
+  }
+}
+
 TEST(FocalPointReprojectionFactor, PointBehindCameraGivesCappedErrorAndZeroJacobians) {
   Values values;
   values.insert(poseKey(0), Pose3());

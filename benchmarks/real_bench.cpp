@@ -11,8 +11,9 @@
 //           point initialiser and refines its poses with the curve pipeline;
 //   hybrid  as curves plus the flags of --hybrid-flags (default `--ba-points true`: points and
 //           curves in one BA);
-//   colmap  COLMAP's feature_extractor (the set's fixed intrinsics, one camera), sequential
-//           matcher, mapper and model_converter, when `colmap` is on PATH.
+//   colmap  COLMAP's feature_extractor (the set's intrinsics, one camera, kept fixed unless
+//           --colmap-refine-focal), sequential matcher, mapper and model_converter, when `colmap`
+//           is on PATH.
 // curves and hybrid run once per start of --starts (issue 14's diagnosis): init (no initial
 // poses: the point initialiser's), truth (the ground truth at the images), noise (the truth with
 // every pose perturbed on its own, once per seed of --noise-seeds: a world-frame shift of
@@ -151,6 +152,9 @@ struct BenchOptions {
   /// noise's own sigmas (a start known per pose to within them) and no motion prior, whose model
   /// (accurate consecutive motions) such a start does not follow.
   bool noise_start_prior = false;
+  /// Let COLMAP's mapper refine the focal length (`--Mapper.ba_refine_focal_length 1`), the peer
+  /// of curvesfm's `--points-ba-refine-focal`; by default both keep the set's calibration.
+  bool colmap_refine_focal = false;
   /// Where every start file's world origin lies: "native" (the set's ground-truth frame, or
   /// COLMAP's) or "first" (moved, by a translation, to the first camera's centre).
   std::string start_origin = "native";
@@ -616,7 +620,8 @@ void runColmap(const BenchOptions& options, const std::string& colmap,
   const fs::path sparse = dir / "sparse";
   fs::remove_all(sparse);
   fs::create_directories(sparse);
-  // The intrinsics are the dataset's calibration: COLMAP keeps them fixed, as curvesfm does.
+  // The intrinsics are the dataset's calibration: COLMAP keeps them fixed, as curvesfm does,
+  // unless asked to refine the focal length.
   const std::vector<std::string> map = {"--database_path",
                                         database,
                                         "--image_path",
@@ -626,7 +631,7 @@ void runColmap(const BenchOptions& options, const std::string& colmap,
                                         "--Mapper.num_threads",
                                         threads,
                                         "--Mapper.ba_refine_focal_length",
-                                        "0",
+                                        options.colmap_refine_focal ? "1" : "0",
                                         "--Mapper.ba_refine_principal_point",
                                         "0",
                                         "--Mapper.ba_refine_extra_params",
@@ -665,6 +670,9 @@ void runColmap(const BenchOptions& options, const std::string& colmap,
   row->total_s = bench::secondsSince(start);
   row->registered = static_cast<int>(best.size());
   if (models.size() > 1) row->note = std::to_string(models.size()) + " models, the largest kept";
+  if (options.colmap_refine_focal) {
+    row->note += std::string(row->note.empty() ? "" : "; ") + "focal length refined";
+  }
   if (best.empty()) {
     row->status = "failed";
     if (row->note.empty()) row->note = "the mapper built no model";
@@ -1365,6 +1373,10 @@ int main(int argc, char** argv) {
   app.add_option("--noise-start-prior", options.noise_start_prior,
                  "Noise starts: run with --ba-start-prior at the noise's own sigmas (each pose "
                  "known to within them) instead of the motion prior")
+      ->capture_default_str();
+  app.add_option("--colmap-refine-focal", options.colmap_refine_focal,
+                 "COLMAP's mapper refines the focal length (the peer of --init-flags "
+                 "\"--points-ba-refine-focal true\"); by default it keeps the set's calibration")
       ->capture_default_str();
   app.add_option("--start-origin", options.start_origin,
                  "Where the start files' world origin lies: native (the set's frame) or first "

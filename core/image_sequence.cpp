@@ -6,8 +6,11 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <iomanip>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
+#include <sstream>
 #include <system_error>
 
 #include "core/errors.h"
@@ -926,6 +929,16 @@ Camera parseCameraString(const std::string& text, int width, int height) {
   k.width = width;
   k.height = height;
   return Camera(k);
+}
+
+std::string formatCameraString(const Camera& camera) {
+  const CameraIntrinsics& c = camera.intrinsics();
+  std::vector<double> values = {c.fx, c.fy, c.cx, c.cy};
+  if (camera.hasDistortion()) values.insert(values.end(), {c.k1, c.k2, c.p1, c.p2, c.k3});
+  std::ostringstream text;
+  text << std::setprecision(std::numeric_limits<double>::max_digits10);
+  for (std::size_t i = 0; i < values.size(); ++i) text << (i ? "," : "") << values[i];
+  return text.str();
 }
 
 DatasetLayout detectDatasetLayout(const std::string& dir) {

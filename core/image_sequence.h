@@ -117,5 +117,9 @@ DatasetLayout detectDatasetLayout(const std::string& dir);
 /// Parses the camera string of ImageSequenceOptions::camera for an image of width x height
 /// pixels. InvalidOptions "ImageSequenceOptions.camera = ..." naming what is wrong.
 Camera parseCameraString(const std::string& text, int width, int height);
+/// The camera as parseCameraString() reads it: "fx,fy,cx,cy", and the five distortion
+/// coefficients when it has any, every number in as many digits as it takes to read back the
+/// same double (the image size is not part of it).
+std::string formatCameraString(const Camera& camera);
 
 }  // namespace curvesfm

@@ -79,20 +79,6 @@ void trackSequence(const ImageSequence& sequence, PointInitialiser* initialiser,
 // correction of a camera given roughly (7-Scenes' colour camera: 4 %).
 constexpr double kImplausibleFocalChange = 0.15;
 
-// The camera as `--camera` takes it: fx,fy,cx,cy and, when it has any, the distortion.
-std::string cameraFlagValue(const Camera& camera) {
-  const CameraIntrinsics& c = camera.intrinsics();
-  std::vector<double> values = {c.fx, c.fy, c.cx, c.cy};
-  if (camera.hasDistortion()) values.insert(values.end(), {c.k1, c.k2, c.p1, c.p2, c.k3});
-  std::string text;
-  char number[32];
-  for (const double value : values) {
-    std::snprintf(number, sizeof(number), "%.9g", value);
-    text += (text.empty() ? "" : ",") + std::string(number);
-  }
-  return text;
-}
-
 void printRefinedFocal(const Camera& given, double focal_scale) {
   if (focal_scale == 1.0) return;
   const Camera refined = given.withFocalScale(focal_scale);
@@ -100,7 +86,7 @@ void printRefinedFocal(const Camera& given, double focal_scale) {
       "init: focal lengths refined x%.4f: fx %.2f, fy %.2f px (given %.2f, %.2f); the same "
       "camera for another run: --camera %s\n",
       focal_scale, refined.fx(), refined.fy(), given.fx(), given.fy(),
-      cameraFlagValue(refined).c_str());
+      formatCameraString(refined).c_str());
   if (std::abs(focal_scale - 1.0) > kImplausibleFocalChange) {
     std::printf(
         "init: warning: the refined focal length is %.0f %% off the one given: implausible for a "

@@ -156,9 +156,12 @@ class GraphSchurProblem {
   GraphSchurProblem(const FactorGraph& graph, const Values& values, const ProblemConfig& config)
       : graph_(graph) {
     collectSlots(values, config);
+    if (has_free_intrinsic_) return;  // Refused: no groups to form.
     formGroups();
     planFactors();
   }
+
+  bool hasFreeIntrinsic() const { return has_free_intrinsic_; }
 
   int numPoses() const { return num_poses_; }
   int reducedDimension() const { return kPoseDim * num_poses_; }
@@ -335,8 +338,11 @@ class GraphSchurProblem {
       Slot slot{variable.key, variable.type, variable.ambient, tangentDim(variable.type)};
       if (variable.free) {
         ++num_free_;
-        // Poses by type, so that a pose always has kPoseDim columns; the rest is structure.
+        // Poses by type, so that a pose always has kPoseDim columns; the rest is structure,
+        // but for an intrinsic: the reduced system holds poses only, and as structure a
+        // variable every observation shares would join all the structure into one group.
         if (slot.type == VariableType::kPose3) slot.pose = num_poses_++;
+        if (categoryOf(variable.key) == VariableCategory::kIntrinsics) has_free_intrinsic_ = true;
       }
       slots_.push_back(slot);
     }
@@ -652,6 +658,7 @@ class GraphSchurProblem {
   double fixed_cost_ = 0.0;
   int num_poses_ = 0;
   int num_free_ = 0;
+  bool has_free_intrinsic_ = false;
   // The solve reads linearizations_[current_]; a trial step is linearised into the other.
   std::array<Linearization, 2> linearizations_;
   int current_ = 0;
@@ -761,18 +768,12 @@ std::optional<OptimizationSummary> optimizeWithGraphSchur(const FactorGraph& gra
     *why_not = options.use_inner_iterations ? "inner iterations" : "the dogleg trust region";
     return std::nullopt;
   }
-  for (const auto& factor : graph) {
-    for (const Key key : factor->keys()) {
-      if (categoryOf(key) == VariableCategory::kIntrinsics && !config.isConstant(key)) {
-        // Its reduced system holds poses only, and as structure a variable that every
-        // observation shares would join all the structure into one group.
-        *why_not = "a free camera intrinsic";
-        return std::nullopt;
-      }
-    }
-  }
   const auto start = Clock::now();
   GraphSchurProblem problem(graph, *values, config);
+  if (problem.hasFreeIntrinsic()) {
+    *why_not = "a free camera intrinsic";
+    return std::nullopt;
+  }
   if (problem.reducedDimension() > kGraphSchurMaxReducedDimension) {
     *why_not = std::to_string(problem.numPoses()) + " free poses (at most " +
                std::to_string(kGraphSchurMaxReducedDimension / kPoseDim) + ")";

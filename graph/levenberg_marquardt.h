@@ -47,7 +47,10 @@ class TrustRegionRadius {
 };
 
 /// OptimizerOptions::stall_iterations: true once the lowest cost so far fell by less than
-/// `tolerance` of itself over the last `window` iterations. window 0 never stalls.
+/// `tolerance` of itself over the last `window` iterations. window 0 never stalls. The window
+/// opens at the first step that lowers the cost: the rejected steps before it shrink the trust
+/// region from its first radius (global BA's 1e4 takes five of them to reach 0.3), a search for
+/// the step's scale rather than a stall, and a solve ended there would never have moved.
 class StallTest {
  public:
   StallTest(int window, double tolerance, double start_cost)
@@ -55,6 +58,7 @@ class StallTest {
   /// After each iteration, with the cost it ended at.
   bool stalled(double cost) {
     if (window_ <= 0) return false;
+    if (lowest_.size() == 1 && !(cost < lowest_.back())) return false;  // No step kept yet.
     lowest_.push_back(std::min(lowest_.back(), cost));
     const std::size_t n = lowest_.size() - 1;  // Iterations so far.
     if (n < static_cast<std::size_t>(window_)) return false;

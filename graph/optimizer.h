@@ -83,10 +83,12 @@ struct OptimizerOptions {
   double gradient_tolerance = 1e-10;  ///< Stop when max |gradient| < this; > 0.
   double parameter_tolerance = 1e-8;  ///< Stop when |dx| / (|x| + tol) < this; > 0.
   /// Stop when the lowest cost so far fell by less than stall_tolerance of itself over the
-  /// last stall_iterations iterations, kept or rejected; 0: off, >= 0. The nearest-edge cost
-  /// is rough at the pixel scale: near its minimum Levenberg-Marquardt alternates rejected
-  /// steps with kept ones that gain a millionth, which function_tolerance (one step's change)
-  /// does not end (docs/benchmarks.md, "A budget for re-association's global BAs").
+  /// last stall_iterations iterations, kept or rejected, counted from the first step that lowers
+  /// the cost (the rejected ones before it shrink the first trust region); 0: off, >= 0. The
+  /// nearest-edge cost is rough at the pixel scale: near its minimum Levenberg-Marquardt
+  /// alternates rejected steps with kept ones that gain a millionth, which function_tolerance
+  /// (one step's change) does not end (docs/benchmarks.md, "A budget for re-association's
+  /// global BAs").
   int stall_iterations = 0;
   double stall_tolerance = 1e-3;  ///< See stall_iterations; > 0.
   /// Schur elimination order: structure first, poses last. Falls back to Ceres' automatic

@@ -262,7 +262,7 @@ void addOptimizerOptions(OptionsTable* table, OptimizerOptions* o, const OptionP
               place.describe("stop when the relative step falls below this"))
       .number("stall_iterations", "stall-iterations", &o->stall_iterations,
               place.describe("stop when the lowest cost fell by less than the stall tolerance "
-                             "over this many iterations (0: off)"))
+                             "over this many iterations, from the first kept step (0: off)"))
       .number("stall_tolerance", "stall-tolerance", &o->stall_tolerance,
               place.describe("relative fall of the lowest cost over the stall iterations"))
       .boolean("structure_first_ordering", "structure-first", &o->structure_first_ordering,

@@ -224,5 +224,16 @@ TEST(StallTest, ComparesTheLowestCostAcrossTheWindow) {
   EXPECT_TRUE(stall.stalled(44.0));   // 45 -> 44 over two.
 }
 
+// Rejected steps before the first kept one search the trust region's scale: the window opens
+// at the first step that lowers the cost, so a solve is not ended before it has moved.
+TEST(StallTest, OpensItsWindowAtTheFirstStepThatLowersTheCost) {
+  StallTest stall(2, 0.1, 100.0);
+  for (int rejected = 0; rejected < 6; ++rejected) EXPECT_FALSE(stall.stalled(130.0));
+  EXPECT_FALSE(stall.stalled(100.0));  // Equal is not lower: still searching.
+  EXPECT_FALSE(stall.stalled(60.0));   // The first kept step: one iteration in the window.
+  EXPECT_FALSE(stall.stalled(59.0));   // 100 -> 59 over two.
+  EXPECT_TRUE(stall.stalled(58.0));    // 60 -> 58 over two.
+}
+
 }  // namespace
 }  // namespace curvesfm

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/errors.h"
+#include "test/support/cameras.h"
 
 namespace curvesfm {
 namespace {
@@ -441,18 +442,7 @@ TEST_F(DatasetIoTest, WriteCameraYamlRoundTripsExactly) {
   intrinsics.height = 479;
   const std::string path = (folder_ / "camera.yaml").string();
   writeCameraYaml(path, Camera(intrinsics));
-  const CameraIntrinsics back = readCameraYaml(path).intrinsics();
-  EXPECT_EQ(back.fx, intrinsics.fx);
-  EXPECT_EQ(back.fy, intrinsics.fy);
-  EXPECT_EQ(back.cx, intrinsics.cx);
-  EXPECT_EQ(back.cy, intrinsics.cy);
-  EXPECT_EQ(back.k1, intrinsics.k1);
-  EXPECT_EQ(back.k2, intrinsics.k2);
-  EXPECT_EQ(back.p1, intrinsics.p1);
-  EXPECT_EQ(back.p2, intrinsics.p2);
-  EXPECT_EQ(back.k3, intrinsics.k3);
-  EXPECT_EQ(back.width, 641);
-  EXPECT_EQ(back.height, 479);
+  testing::expectSameIntrinsics(readCameraYaml(path).intrinsics(), intrinsics);
   EXPECT_THAT(read(path), HasSubstr("%YAML:1.0\n"));
 }
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/errors.h"
+#include "test/support/cameras.h"
 #include "test/support/temp_folder.h"
 
 namespace curvesfm {
@@ -114,15 +115,8 @@ TEST(CameraString, FormattedCameraReadsBackTheSameIntrinsics) {
   const Camera distorted(
       CameraIntrinsics{546.6773, 546.6773, 319.5, 239.5, 0.1 / 3, -0.2, 1e-3, 0.0, 0.0, 640, 480});
   const std::string text = formatCameraString(distorted);
-  const CameraIntrinsics read = parseCameraString(text, 640, 480).intrinsics();
-  const CameraIntrinsics& given = distorted.intrinsics();
-  EXPECT_EQ(read.fx, given.fx) << text;
-  EXPECT_EQ(read.fy, given.fy);
-  EXPECT_EQ(read.cx, given.cx);
-  EXPECT_EQ(read.cy, given.cy);
-  EXPECT_EQ(read.k1, given.k1);
-  EXPECT_EQ(read.k2, given.k2);
-  EXPECT_EQ(read.p1, given.p1);
+  testing::expectSameIntrinsics(parseCameraString(text, 640, 480).intrinsics(),
+                                distorted.intrinsics(), text);
   // A pinhole camera gives its four numbers only.
   EXPECT_EQ(
       formatCameraString(Camera(CameraIntrinsics{525, 525, 320, 240, 0, 0, 0, 0, 0, 640, 480})),

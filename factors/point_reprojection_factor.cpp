@@ -72,11 +72,12 @@ FocalPointReprojectionFactor::Error FocalPointReprojectionFactor::evaluateError(
     if (H_scale) H_scale->setZero();
     return Error::Constant(PointReprojectionFactor::kBehindCameraError);
   }
-  const Eigen::Vector2d from_centre = pixel - Eigen::Vector2d(camera_->cx(), camera_->cy());
+  const Eigen::Vector2d centre(camera_->cx(), camera_->cy());
+  const Eigen::Vector2d from_centre = pixel - centre;
   if (H_pose) *H_pose *= focal_scale;
   if (H_point) *H_point *= focal_scale;
   if (H_scale) *H_scale = from_centre;
-  return Eigen::Vector2d(camera_->cx(), camera_->cy()) + focal_scale * from_centre - measured_;
+  return centre + focal_scale * from_centre - measured_;
 }
 
 }  // namespace curvesfm

@@ -37,12 +37,16 @@
 // registered image) is compared with the set's ground truth from loadImageSequence by
 // compareTrajectories (Sim(3), core/trajectory_evaluation.h).
 //
-// Writes into --out: real_bench.csv (one row per set and variant), real_bench.md (the table, also
-// printed), SET/groundtruth.txt and SET/VARIANT/aligned_trajectory.txt (the estimate carried onto
-// the ground truth), each run's own output and logs in SET/VARIANT/, and through `python3 -m
-// curvesfm_plots real-bench OUT` (when matplotlib is there) ate_by_set.png and trajectories.png.
-// Exit codes: 0 when every row was written (failed and skipped rows included), 1 for bad input
-// (no data folder, no known set in it), 2 for usage errors.
+// --repetitions N runs every set's variants N times, interleaved (each once, then all again), and
+// prints each curvesfm run's wall time against COLMAP's per repetition and their median (the
+// machines these benches run on change speed over minutes; one pair of runs can be 40 % off).
+//
+// Writes into --out: real_bench.csv (one row per set, variant and repetition), real_bench.md (the
+// table, also printed), SET/groundtruth.txt and SET/VARIANT/aligned_trajectory.txt (the estimate
+// carried onto the ground truth), each run's own output and logs in SET/VARIANT/, and through
+// `python3 -m curvesfm_plots real-bench OUT` (when matplotlib is there) ate_by_set.png and
+// trajectories.png. Exit codes: 0 when every row was written (failed and skipped rows included), 1
+// for bad input (no data folder, no known set in it), 2 for usage errors.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
@@ -51,6 +55,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -143,6 +148,10 @@ struct BenchOptions {
   /// tracks' time per frame issue 13's one-core figure; an end-to-end comparison with COLMAP,
   /// whose feature extraction runs on `threads`, gives it as many.
   int tracking_threads = 1;
+  /// Every set's variants run this many times, interleaved (each variant once, then all again),
+  /// so that a machine whose speed drifts over minutes slows curvesfm and COLMAP alike; the
+  /// accuracy summaries read the first repetition, the time summary every one.
+  int repetitions = 1;
   std::vector<std::string> starts = {"init"};      ///< Starts of the curves and hybrid variants.
   std::vector<int> noise_seeds = {1, 2, 3, 4, 5};  ///< One noise start per seed.
   /// Shift per axis of a noise start, as a fraction of the median camera spacing (unitless).
@@ -191,6 +200,7 @@ struct Row {
   std::string set;
   std::string variant;
   std::string start;          ///< Start label of curves and hybrid rows; empty for the others.
+  int repetition = 1;         ///< Which of BenchOptions::repetitions (from 1).
   std::string status = "ok";  ///< ok, failed or skipped.
   std::string note;           ///< Why it failed or was skipped; caps and flags otherwise.
   int frames = 0;             ///< Images of the set after caps.
@@ -703,7 +713,8 @@ bool evaluated(const Row& r) { return r.status == "ok"; }
 void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
   std::ofstream out(path);
   if (!out) throw IoError(path.string(), "cannot open for writing");
-  out << "set,variant,start,status,frames,registered,evaluated,start_ate_rmse,ate_rmse,ate_mean,"
+  out << "set,variant,start,repetition,status,frames,registered,evaluated,start_ate_rmse,ate_rmse,"
+         "ate_mean,"
          "ate_median,map_precision_2cm,map_recall_2cm,curve_cost_per_observation,"
          "rpe_translation_rmse,tracks_s,tracks_ms_per_640x480_frame,init_s,curves_s,local_ba_s,"
          "global_ba_s,extraction_s,"
@@ -711,10 +722,10 @@ void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
   for (const Row& r : rows) {
     const bool ok = evaluated(r);
     const double nan = std::nan("");
-    out << r.set << "," << r.variant << "," << r.start << "," << r.status << "," << r.frames << ","
-        << r.registered << "," << r.evaluated << "," << formatNumber(r.start_ate, "%.9g") << ","
-        << formatNumber(ok ? r.ate.rmse : nan, "%.9g") << ","
-        << formatNumber(ok ? r.ate.mean : nan, "%.9g") << ","
+    out << r.set << "," << r.variant << "," << r.start << "," << r.repetition << "," << r.status
+        << "," << r.frames << "," << r.registered << "," << r.evaluated << ","
+        << formatNumber(r.start_ate, "%.9g") << "," << formatNumber(ok ? r.ate.rmse : nan, "%.9g")
+        << "," << formatNumber(ok ? r.ate.mean : nan, "%.9g") << ","
         << formatNumber(ok ? r.ate.median : nan, "%.9g") << ","
         << formatNumber(r.map_precision, "%.4g") << "," << formatNumber(r.map_recall, "%.4g") << ","
         << formatNumber(r.curve_cost_per_observation, "%.6g") << ","
@@ -739,7 +750,11 @@ std::string markdownRow(const Row& r) {
   std::string note = r.note;
   std::replace(note.begin(), note.end(), '|', '/');
   std::ostringstream line;
-  line << "| " << r.set << " | " << r.variant << " | " << r.start << " | "
+  std::string start = r.start;
+  if (r.repetition > 1) {
+    start += (start.empty() ? "" : ", ") + std::string("run ") + std::to_string(r.repetition);
+  }
+  line << "| " << r.set << " | " << r.variant << " | " << start << " | "
        << (r.status == "skipped" ? "skipped"
                                  : std::to_string(r.registered) + " / " + std::to_string(r.frames))
        << " | " << (ok ? std::to_string(r.evaluated) : "") << " | " << formatNumber(r.start_ate)
@@ -776,10 +791,11 @@ std::string markdownTable(const std::vector<Row>& rows, int tracking_threads) {
 
 void printProgress(const Row& r, int done, int total) {
   if (r.status == "ok") {
-    std::printf("[%d/%d] %s %s%s: %d/%d registered, %d evaluated, ATE rmse %.4g", done, total,
+    std::printf("[%d/%d] %s %s%s%s: %d/%d registered, %d evaluated, ATE rmse %.4g", done, total,
                 r.set.c_str(), r.variant.c_str(),
-                r.start.empty() ? "" : (" from " + r.start).c_str(), r.registered, r.frames,
-                r.evaluated, r.ate.rmse);
+                r.start.empty() ? "" : (" from " + r.start).c_str(),
+                r.repetition > 1 ? (", run " + std::to_string(r.repetition)).c_str() : "",
+                r.registered, r.frames, r.evaluated, r.ate.rmse);
     if (!std::isnan(r.start_ate)) std::printf(" (start %.4g)", r.start_ate);
     std::printf(", %.1f s\n", r.total_s);
   } else {
@@ -870,6 +886,43 @@ void printFitSummary(const std::vector<Row>& rows) {
       }
     }
     std::printf("\n");
+  }
+}
+
+/// Per set and curvesfm run: its wall time against COLMAP's on the same set in the same
+/// repetition (issue 15: images to refined trajectory in <= 0.25 x COLMAP's), each repetition's
+/// ratio and their median. The runs of one repetition follow each other, so a machine whose
+/// speed drifts between them moves a single ratio; the median over interleaved repetitions less.
+void printTimeBesideColmap(const std::vector<Row>& rows) {
+  std::map<std::pair<std::string, int>, double> colmap_seconds;  // (set, repetition) -> s
+  for (const Row& r : rows) {
+    if (r.variant == "colmap" && r.status == "ok")
+      colmap_seconds[{r.set, r.repetition}] = r.total_s;
+  }
+  struct Times {
+    std::vector<double> ours, colmap, ratios;
+  };
+  std::map<std::string, Times> runs;  // "set variant[ from start]" -> one entry per repetition
+  std::vector<std::string> order;
+  for (const Row& r : rows) {
+    const auto colmap = colmap_seconds.find({r.set, r.repetition});
+    if (r.variant == "colmap" || r.status != "ok" || colmap == colmap_seconds.end()) continue;
+    const std::string key = r.set + " " + r.variant + (r.start.empty() ? "" : " from " + r.start);
+    if (runs.count(key) == 0) order.push_back(key);
+    Times& times = runs[key];
+    times.ours.push_back(r.total_s);
+    times.colmap.push_back(colmap->second);
+    times.ratios.push_back(r.total_s / colmap->second);
+  }
+  for (const std::string& key : order) {
+    const Times& times = runs[key];
+    std::printf(
+        "time %s: %.1f s against COLMAP's %.1f s, %.3f x (medians over %zu repetition(s); "
+        "each:",
+        key.c_str(), upperMedian(times.ours), upperMedian(times.colmap), upperMedian(times.ratios),
+        times.ratios.size());
+    for (double ratio : times.ratios) std::printf(" %.3f", ratio);
+    std::printf(")\n");
   }
 }
 
@@ -1123,18 +1176,22 @@ struct SetRun {
 };
 
 // Runs one variant from one start into its own folder and returns its row.
-Row runRow(const SetRun& run, const Variant& variant, const Start& start, int number, int total) {
+Row runRow(const SetRun& run, const Variant& variant, const Start& start, int repetition,
+           int number, int total) {
   Row row;
   row.set = run.set.name;
   row.variant = variant.name;
   if (variant.command == "run") row.start = start.label();
+  row.repetition = repetition;
   row.frames = static_cast<int>(run.sequence.images.size());
-  const fs::path dir =
-      run.set_dir / (start.kind == "init" ? variant.name : variant.name + "_" + start.label());
+  std::string name = start.kind == "init" ? variant.name : variant.name + "_" + start.label();
+  if (repetition > 1) name += "_run" + std::to_string(repetition);
+  const fs::path dir = run.set_dir / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
-  std::printf("[%d/%d] %s %s%s: running\n", number, total, run.set.name.c_str(),
-              variant.name.c_str(), row.start.empty() ? "" : (" from " + row.start).c_str());
+  std::printf("[%d/%d] %s %s%s%s: running\n", number, total, run.set.name.c_str(),
+              variant.name.c_str(), row.start.empty() ? "" : (" from " + row.start).c_str(),
+              repetition > 1 ? (", run " + std::to_string(repetition)).c_str() : "");
   std::fflush(stdout);
   Variant run_variant = variant;  // with --map-at's flag once its poses file exists
   try {
@@ -1182,9 +1239,14 @@ void reportRows(const std::vector<Row>& rows, const BenchOptions& options,
     if (!md) throw IoError((out / "real_bench.md").string(), "cannot write");
   }
   std::printf("\n%s\n", table.c_str());
-  printSummary(rows, options.variants);
-  printStartSummary(rows);
-  printFitSummary(rows);
+  // Every repetition of a run is the same computation: the accuracy is read once.
+  std::vector<Row> first;
+  std::copy_if(rows.begin(), rows.end(), std::back_inserter(first),
+               [](const Row& r) { return r.repetition == 1; });
+  printSummary(first, options.variants);
+  printStartSummary(first);
+  printFitSummary(first);
+  printTimeBesideColmap(rows);
 }
 
 int run(const BenchOptions& options, const std::string& command) {
@@ -1211,7 +1273,7 @@ int run(const BenchOptions& options, const std::string& command) {
   std::vector<Row> rows;
   int rows_per_set = 0;
   for (const Variant& variant : variants) {
-    rows_per_set += static_cast<int>(startsOf(variant, options).size());
+    rows_per_set += static_cast<int>(startsOf(variant, options).size()) * options.repetitions;
   }
   const int total = static_cast<int>(sets.size()) * rows_per_set;
   for (const RealSet& set : sets) {
@@ -1224,13 +1286,16 @@ int run(const BenchOptions& options, const std::string& command) {
     std::vector<StampedPose> colmap_poses;
     const SetRun set_run{options, set,    *sequence,  sequence_options, set_dir,
                          note,    colmap, &catalogue, &colmap_poses};
-    for (const Variant& variant : variants) {
-      for (const Start& start : startsOf(variant, options)) {
-        rows.push_back(runRow(set_run, variant, start, static_cast<int>(rows.size()) + 1, total));
-        printProgress(rows.back(), static_cast<int>(rows.size()), total);
-        // Rewritten after every row, so that a long bench stopped half-way keeps what it
-        // measured.
-        writeCsv(rows, out / "real_bench.csv");
+    for (int repetition = 1; repetition <= options.repetitions; ++repetition) {
+      for (const Variant& variant : variants) {
+        for (const Start& start : startsOf(variant, options)) {
+          rows.push_back(runRow(set_run, variant, start, repetition,
+                                static_cast<int>(rows.size()) + 1, total));
+          printProgress(rows.back(), static_cast<int>(rows.size()), total);
+          // Rewritten after every row, so that a long bench stopped half-way keeps what it
+          // measured.
+          writeCsv(rows, out / "real_bench.csv");
+        }
       }
     }
   }
@@ -1413,6 +1478,12 @@ int main(int argc, char** argv) {
                  "frame are per core; --threads for the time beside COLMAP, whose feature "
                  "extraction runs on --threads)")
       ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  app.add_option("--repetitions", options.repetitions,
+                 "Runs every set's variants this many times, interleaved (each once, then all "
+                 "again), and prints each curvesfm run's wall time against COLMAP's per "
+                 "repetition and their median: a shared machine's speed drifts over minutes")
+      ->check(CLI::Range(1, 20))
       ->capture_default_str();
   const std::string command = curvesfm::bench::commandLine(argc, argv);
   return curvesfm::bench::parseAndRun(app, argc, argv,

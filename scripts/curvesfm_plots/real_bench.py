@@ -1,5 +1,6 @@
 """`real-bench`: the figures of benchmarks/real_bench from what it writes into its output folder:
-real_bench.csv (one row per set, variant and start), SET/groundtruth.txt and
+real_bench.csv (one row per set, variant, start and repetition; the first repetition is drawn),
+SET/groundtruth.txt and
 SET/RUN/aligned_trajectory.txt (TUM, the estimate after its Sim(3) alignment), RUN being the
 variant, or VARIANT_START for a curve run from another start than the initialiser's (the bar
 and line labels too).
@@ -19,9 +20,10 @@ VARIANTS = ("init", "curves", "hybrid", "colmap")
 COLUMNS = ("set", "variant", "status", "ate_rmse")
 
 
-def draw(out_dir):
-    path = os.path.join(out_dir, "real_bench.csv")
-    rows = read_csv(path, COLUMNS)
+def read_rows(path):
+    """The rows of the first repetition (--repetitions runs the same computation again for its
+    time), each variant named as its run folder, ate_rmse a number."""
+    rows = [r for r in read_csv(path, COLUMNS) if r.get("repetition", "1") in ("", "1")]
     if not rows:
         raise InputError("%s: no rows: nothing to draw" % path)
     for r in rows:
@@ -29,6 +31,11 @@ def draw(out_dir):
         start = r.get("start", "")
         if start not in ("", "init"):
             r["variant"] = "%s_%s" % (r["variant"], start)
+    return rows
+
+
+def draw(out_dir):
+    rows = read_rows(os.path.join(out_dir, "real_bench.csv"))
     sets = []
     for r in rows:
         if r["set"] not in sets:

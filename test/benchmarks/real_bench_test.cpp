@@ -26,6 +26,14 @@ TEST(RealBenchCommandLine, RejectsAnUnknownVariant) {
               HasSubstr("--variants: 'points' is not one of init, curves, hybrid, colmap"));
 }
 
+TEST(RealBenchCommandLine, RejectsRepetitionsOutsideOneToTwenty) {
+  for (const char* count : {"0", "21"}) {
+    const testing::CommandResult r = runRealBench(std::string("--repetitions ") + count);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("--repetitions")) << count;
+  }
+}
+
 TEST(RealBenchCommandLine, RejectsAnUnknownSet) {
   const testing::CommandResult r = runRealBench("--sets kitti");
   EXPECT_EQ(r.exit_code, 2) << r.output;

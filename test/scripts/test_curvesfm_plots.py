@@ -240,6 +240,18 @@ class RealBenchFiguresTest(unittest.TestCase):
         self.assertEqual([os.path.basename(p) for p in paths],
                          ["ate_by_set.png", "trajectories.png"])
 
+    def test_draws_the_first_repetition_only(self):
+        header = "set,variant,start,repetition,status,ate_rmse,note\n"
+        rows = ("a,curves,truth,1,ok,0.01,\"\"\n"
+                "a,colmap,,1,ok,0.02,\"\"\n"
+                "a,curves,truth,2,ok,0.01,\"\"\n"
+                "a,colmap,,2,ok,0.03,\"\"\n")
+        with tempfile.TemporaryDirectory() as d:
+            write(d, "real_bench.csv", header + rows)
+            read = real_bench.read_rows(os.path.join(d, "real_bench.csv"))
+        self.assertEqual([(r["variant"], r["ate_rmse"]) for r in read],
+                         [("curves_truth", 0.01), ("colmap", 0.02)])
+
     def test_missing_trajectory_names_the_file(self):
         with tempfile.TemporaryDirectory() as d:
             self.write_bench(d)

@@ -43,10 +43,11 @@
 //
 // Writes into --out: real_bench.csv (one row per set, variant and repetition), real_bench.md (the
 // table, also printed), SET/groundtruth.txt and SET/VARIANT/aligned_trajectory.txt (the estimate
-// carried onto the ground truth), each run's own output and logs in SET/VARIANT/, and through
-// `python3 -m curvesfm_plots real-bench OUT` (when matplotlib is there) ate_by_set.png and
-// trajectories.png. Exit codes: 0 when every row was written (failed and skipped rows included), 1
-// for bad input (no data folder, no known set in it), 2 for usage errors.
+// carried onto the ground truth), each run's own output and logs in SET/VARIANT/ (a later
+// repetition's in SET/VARIANT_runN/), and through `python3 -m curvesfm_plots real-bench OUT`
+// (when matplotlib is there) ate_by_set.png and trajectories.png. Exit codes: 0 when every row
+// was written (failed and skipped rows included), 1 for bad input (no data folder, no known set
+// in it), 2 for usage errors.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>

@@ -790,12 +790,17 @@ std::string markdownTable(const std::vector<Row>& rows, int tracking_threads) {
   return out.str();
 }
 
+// " from START, run N" as the progress lines name a run: no start for init and COLMAP, no
+// number for the first repetition.
+std::string runSuffix(const std::string& start, int repetition) {
+  return (start.empty() ? "" : " from " + start) +
+         (repetition > 1 ? ", run " + std::to_string(repetition) : "");
+}
+
 void printProgress(const Row& r, int done, int total) {
   if (r.status == "ok") {
-    std::printf("[%d/%d] %s %s%s%s: %d/%d registered, %d evaluated, ATE rmse %.4g", done, total,
-                r.set.c_str(), r.variant.c_str(),
-                r.start.empty() ? "" : (" from " + r.start).c_str(),
-                r.repetition > 1 ? (", run " + std::to_string(r.repetition)).c_str() : "",
+    std::printf("[%d/%d] %s %s%s: %d/%d registered, %d evaluated, ATE rmse %.4g", done, total,
+                r.set.c_str(), r.variant.c_str(), runSuffix(r.start, r.repetition).c_str(),
                 r.registered, r.frames, r.evaluated, r.ate.rmse);
     if (!std::isnan(r.start_ate)) std::printf(" (start %.4g)", r.start_ate);
     std::printf(", %.1f s\n", r.total_s);
@@ -908,7 +913,7 @@ void printTimeBesideColmap(const std::vector<Row>& rows) {
   for (const Row& r : rows) {
     const auto colmap = colmap_seconds.find({r.set, r.repetition});
     if (r.variant == "colmap" || r.status != "ok" || colmap == colmap_seconds.end()) continue;
-    const std::string key = r.set + " " + r.variant + (r.start.empty() ? "" : " from " + r.start);
+    const std::string key = r.set + " " + r.variant + runSuffix(r.start, 1);
     if (runs.count(key) == 0) order.push_back(key);
     Times& times = runs[key];
     times.ours.push_back(r.total_s);
@@ -1190,9 +1195,8 @@ Row runRow(const SetRun& run, const Variant& variant, const Start& start, int re
   const fs::path dir = run.set_dir / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
-  std::printf("[%d/%d] %s %s%s%s: running\n", number, total, run.set.name.c_str(),
-              variant.name.c_str(), row.start.empty() ? "" : (" from " + row.start).c_str(),
-              repetition > 1 ? (", run " + std::to_string(repetition)).c_str() : "");
+  std::printf("[%d/%d] %s %s%s: running\n", number, total, run.set.name.c_str(),
+              variant.name.c_str(), runSuffix(row.start, repetition).c_str());
   std::fflush(stdout);
   Variant run_variant = variant;  // with --map-at's flag once its poses file exists
   try {

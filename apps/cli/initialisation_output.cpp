@@ -240,6 +240,12 @@ nlohmann::json initialisationToJson(const ImageSequence& sequence,
             {"models", result.models},
             {"merged_models", result.merged_models},
             {"pairs_tried", result.pairs_tried}}},
+          {"loops",
+           {{"candidate_pairs", result.loops.candidate_pairs},
+            {"verified_pairs", result.loops.verified_pairs},
+            {"matches", result.loops.matches},
+            {"merges", result.loops.merges},
+            {"rounds", result.loops.rounds}}},
           {"scale_convention", result.scale_convention},
           {"focal_scale", result.focal_scale},
           {"initial_pair",
@@ -261,6 +267,7 @@ nlohmann::json initialisationToJson(const ImageSequence& sequence,
             {"local_ba", t.local_ba},
             {"global_ba", t.global_ba},
             {"merge", t.merge},
+            {"loops", t.loops},
             {"total", t.total},
             {"tracks_ms_per_640x480_frame",
              t.tracksMsPerVgaFrame(static_cast<int>(result.frames.size()), sequence.camera.width(),
@@ -296,6 +303,14 @@ nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
       frames > 0 ? 1e3 * (t.klt + t.matching + t.undistort) / frames : 0.0,
       t.tracksMsPerVgaFrame(frames, sequence.camera.width(), sequence.camera.height()),
       t.pair_search, t.registration, t.triangulation, t.local_ba, t.global_ba, t.total);
+  const LoopMatchStats& loops = result.loops;
+  if (loops.candidate_pairs > 0) {
+    std::printf(
+        "init loops: %d candidate pairs (%d verified), %d matches, %d tracks merged in %d "
+        "rounds, %.2f s (global BA counted below)\n",
+        loops.candidate_pairs, loops.verified_pairs, loops.matches, loops.merges, loops.rounds,
+        t.loops);
+  }
   for (const auto& [scope, totals] : baTotals(result)) {
     std::printf("init BA %s: %d solves, %d iterations, %.2f s\n", scope.c_str(), totals.solves,
                 totals.iterations, totals.seconds);

@@ -849,6 +849,22 @@ void addFeatureTrackOptions(OptionsTable* table, FeatureTrackOptions* o, const O
               "A pair with fewer verified matches keeps none");
 }
 
+void addLoopMatchOptions(OptionsTable* table, LoopMatchOptions* o, const OptionPlace& place) {
+  table->group(o, "LoopMatchOptions", place.path, place.prefix, place.heading)
+      .boolean("enabled", "enabled", &o->enabled,
+               "Match frames that see the same scene without shared tracks, and merge tracks")
+      .number("min_covisible_fraction", "min-covisible-fraction", &o->min_covisible_fraction,
+              "A loop candidate: this fraction of one frame's points project into the other")
+      .number("max_view_angle_deg", "max-view-angle", &o->max_view_angle_deg,
+              "...counting only points whose two rays differ by at most this (deg)")
+      .number("max_shared_fraction", "max-shared-fraction", &o->max_shared_fraction,
+              "...and at most this fraction of those are tracked there already")
+      .number("max_merge_error_px", "max-merge-error", &o->max_merge_error_px,
+              "A merged point reprojects within this into every frame of both tracks (px)")
+      .number("max_rounds", "max-rounds", &o->max_rounds,
+              "Most rounds of merges, each followed by global BA");
+}
+
 void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* o,
                                 const std::string& path) {
   const std::string heading = "Point initialiser";
@@ -862,6 +878,7 @@ void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* o,
       .nested("ba")
       .nested("local_ba")
       .nested("global_ba")
+      .nested("loops")
       .number("pair_search_frames", "pair-search-frames", &o->pair_search_frames,
               "The initial pair's first frame is searched among this many frames")
       .number("max_pair_gap", "max-pair-gap", &o->max_pair_gap,
@@ -901,6 +918,7 @@ void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* o,
   addFeatureMatchingOptions(table, &o->features,
                             {path + "/features", "points-features-", heading, ""});
   addFeatureTrackOptions(table, &o->tracks, {path + "/tracks", "points-tracks-", heading, ""});
+  addLoopMatchOptions(table, &o->loops, {path + "/loops", "points-loops-", heading, ""});
   addTwoViewOptions(table, &o->two_view, {path + "/two_view", "points-two-view-", heading, ""});
   addAbsolutePoseOptions(table, &o->registration,
                          {path + "/registration", "points-pnp-", heading, ""});

@@ -82,9 +82,8 @@ int samplesToFind(int needed, int n, int sample_size, int cap) {
   return static_cast<int>(std::clamp(std::ceil(samples), 1.0, double(cap)));
 }
 
-// The matches a fundamental matrix or a homography explains (RANSAC, whichever keeps more), as
-// COLMAP verifies every image pair before it builds tracks: one wrong match joins two scene
-// points into one track. Fewer than `min_matches` survivors: none is kept.
+}  // namespace
+
 std::vector<FeatureMatch> verifiedMatches(const std::vector<FeatureMatch>& matches,
                                           double threshold_px, int min_matches) {
   if (static_cast<int>(matches.size()) < min_matches) return {};
@@ -122,6 +121,8 @@ std::vector<FeatureMatch> verifiedMatches(const std::vector<FeatureMatch>& match
   return kept;
 }
 
+namespace {
+
 struct Keypoint {
   int frame = -1;
   Eigen::Vector2d pixel;
@@ -145,10 +146,8 @@ struct FeatureTrackBuilder::State {
   std::vector<cv::Vec3b> klt_colours;                 // By KLT track id.
   std::vector<Keypoint> keypoints;
   std::vector<std::pair<NodeRef, NodeRef>> links;
-  std::deque<MatchingFrame> window;  // The last match_overlap matching frames.
-  // Every matching frame while the sequence may still be matched exhaustively; emptied once it
-  // has more than exhaustive_max_frames frames.
-  std::vector<MatchingFrame> all_matching;
+  std::vector<MatchingFrame> matching_frames;  // Every matching frame, in frame order.
+  std::set<std::pair<int, int>> matched_pairs;
   // Two consecutive matching frames share no verified match: the order does not follow the views.
   bool out_of_order = false;
   std::vector<FeatureTrackFrameStats> stats;
@@ -204,7 +203,9 @@ struct FeatureTrackBuilder::State {
                          keypointRef(later.first_keypoint + match.index_b));
     }
     stats[later.frame].matches += static_cast<int>(matches.size());
-    if (matches.empty() && !window.empty() && &earlier == &window.back()) out_of_order = true;
+    matched_pairs.emplace(earlier.frame, later.frame);
+    if (matches.empty() && &earlier == &matching_frames[matching_frames.size() - 2])
+      out_of_order = true;
   }
 
   // Matches the pairs of matching frames that the overlap window left out (exhaustive matching
@@ -212,14 +213,13 @@ struct FeatureTrackBuilder::State {
   void matchRemainingPairs() {
     if (!out_of_order || numFrames() > options.exhaustive_max_frames) return;
     const Clock::time_point start = Clock::now();
-    const int n = static_cast<int>(all_matching.size());
+    const int n = static_cast<int>(matching_frames.size());
     for (int j = 0; j < n; ++j) {
       // The window matched frame j with its match_overlap predecessors already.
       for (int i = 0; i + options.match_overlap < j; ++i)
-        matchPair(all_matching[i], all_matching[j]);
+        matchPair(matching_frames[i], matching_frames[j]);
     }
-    if (n > 0) stats[all_matching.back().frame].match_seconds += secondsSince(start);
-    all_matching.clear();
+    if (n > 0) stats[matching_frames.back().frame].match_seconds += secondsSince(start);
   }
 
   void makeMatchingFrame(int frame, const cv::Mat& image) {
@@ -237,12 +237,10 @@ struct FeatureTrackBuilder::State {
     FeatureTrackFrameStats& s = stats[frame];
     s.matching_frame = true;
     s.features = m.features.size();
-    for (const MatchingFrame& earlier : window) matchPair(earlier, m);
-    if (numFrames() <= options.exhaustive_max_frames) all_matching.push_back(m);
-    if (options.match_overlap > 0) {
-      window.push_back(std::move(m));
-      while (static_cast<int>(window.size()) > options.match_overlap) window.pop_front();
-    }
+    matching_frames.push_back(std::move(m));
+    const int later = static_cast<int>(matching_frames.size()) - 1;
+    for (int earlier = std::max(0, later - options.match_overlap); earlier < later; ++earlier)
+      matchPair(matching_frames[earlier], matching_frames[later]);
     last_matching_frame = frame;
     s.match_seconds += secondsSince(start);
   }
@@ -260,7 +258,24 @@ struct FeatureTrackBuilder::State {
     }
     if (frame % options.match_interval == 0 || broken) makeMatchingFrame(frame, image);
     previous_image = image.clone();
-    if (numFrames() > options.exhaustive_max_frames) all_matching.clear();  // Too long now.
+  }
+
+  // Moves the matching frames' features into `out`, each keypoint with its track (index into
+  // out->tracks) where that track observes it at its pixel.
+  void keepMatchingFrames(const std::vector<int>& track_of_keypoint, FeatureTracks* out) {
+    for (MatchingFrame& m : matching_frames) {
+      MatchingFrameFeatures kept{m.frame, std::move(m.features), {}};
+      for (int k = 0; k < kept.features.size(); ++k) {
+        const int track = track_of_keypoint[m.first_keypoint + k];
+        // The frame's observation may be the KLT point the keypoint joined (within the merge
+        // radius) or another one that won the frame.
+        const bool observed_here =
+            track >= 0 && (*out->pixel(track, m.frame) - kept.features.pixels[k]).norm() <=
+                              options.merge_radius_px;
+        kept.track_of_keypoint.push_back(observed_here ? track : -1);
+      }
+      out->matching_frames.push_back(std::move(kept));
+    }
   }
 
   FeatureTracks finish() {
@@ -299,7 +314,10 @@ struct FeatureTrackBuilder::State {
     out.num_frames = frames;
     out.frame_tracks.resize(frames);
     out.frames = stats;
-    for (FeatureTrack& track : joined) {
+    out.matched_pairs = matched_pairs;
+    std::vector<int> kept_index(joined.size(), -1);
+    for (std::size_t j = 0; j < joined.size(); ++j) {
+      FeatureTrack& track = joined[j];
       std::vector<TrackObservation>& obs = track.observations;
       std::stable_sort(
           obs.begin(), obs.end(),
@@ -311,9 +329,14 @@ struct FeatureTrackBuilder::State {
                 obs.end());
       if (obs.size() < 2) continue;
       const int index = static_cast<int>(out.tracks.size());
+      kept_index[j] = index;
       for (const TrackObservation& o : obs) out.frame_tracks[o.frame].push_back(index);
       out.tracks.push_back(std::move(track));
     }
+    std::vector<int> track_of_keypoint(keypoints.size());
+    for (std::size_t k = 0; k < keypoints.size(); ++k)
+      track_of_keypoint[k] = kept_index[track_of_root[sets.find(num_klt + static_cast<int>(k))]];
+    keepMatchingFrames(track_of_keypoint, &out);
     return out;
   }
 };

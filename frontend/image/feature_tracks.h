@@ -1,9 +1,10 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <deque>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "frontend/image/feature_matching.h"
@@ -36,6 +37,11 @@ namespace curvesfm {
 // jump around the ring, so neighbours in the file order are often 50-120 deg apart. Ordered
 // sequences keep the window alone: the extra pairs cost time (fountain-P11: 20 s to 46 s) and
 // gain nothing there.
+//
+// Every matching frame's descriptors are kept in the result, with the track of each keypoint,
+// so that the reconstruction can match pairs the window left out once it knows which frames see
+// the same scene (the point initialiser's loop matches): about 0.5 MB a matching frame with 1000
+// SIFT features.
 //
 // Pixels: undistorted pinhole pixels (as PointTracker's and detectFeatures' input), centres at
 // integers. Deterministic: the same frames give the same tracks.
@@ -92,6 +98,17 @@ struct FeatureTrackFrameStats {
   double match_seconds = 0.0;   ///< Descriptor detection and matching.
 };
 
+/// A matching frame's descriptors, kept so that the reconstruction can match it with frames the
+/// overlap window did not pair it with (the point initialiser's loop matches).
+struct MatchingFrameFeatures {
+  int frame = -1;
+  FeatureSet features;
+  /// Per keypoint, the track (index into FeatureTracks::tracks) that observes it at its pixel,
+  /// or -1: a keypoint no match joined to anything, or one that lost its frame to another
+  /// observation of its track.
+  std::vector<int> track_of_keypoint;
+};
+
 /// Every track of a sequence.
 struct FeatureTracks {
   int num_frames = 0;
@@ -99,11 +116,22 @@ struct FeatureTracks {
   /// Per frame, the tracks observed in it (indices into `tracks`, ascending).
   std::vector<std::vector<int>> frame_tracks;
   std::vector<FeatureTrackFrameStats> frames;
+  /// Every matching frame, in frame order.
+  std::vector<MatchingFrameFeatures> matching_frames;
+  /// The pairs of matching frames (earlier, later) whose descriptors were matched.
+  std::set<std::pair<int, int>> matched_pairs;
   /// The pixel of track `track` in frame `frame`; nullptr if the track is not seen there.
   const Eigen::Vector2d* pixel(int track, int frame) const;
   /// Tracks observed in both frames.
   std::vector<int> sharedTracks(int frame_a, int frame_b) const;
 };
+
+/// The matches a fundamental matrix or a homography explains within threshold_px (RANSAC,
+/// whichever keeps more), as COLMAP verifies every image pair before it builds tracks: one wrong
+/// match joins two scene points into one track. Fewer than `min_matches` survivors: none is
+/// kept. Deterministic (RANSAC draws from OpenCV's generator, seeded here).
+std::vector<FeatureMatch> verifiedMatches(const std::vector<FeatureMatch>& matches,
+                                          double threshold_px, int min_matches);
 
 /// Builds the tracks frame by frame. Feed every frame of a sequence in order (8-bit BGR or grey,
 /// undistorted, all of one size); not thread-safe.

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <numeric>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -38,8 +40,21 @@ OptimizerOptions PointInitialiserOptions::defaultGlobalSolver() {
   return o;
 }
 
+void LoopMatchOptions::validate() const {
+  const OptionCheck require("LoopMatchOptions");
+  require(min_covisible_fraction > 0.0 && min_covisible_fraction <= 1.0, "min_covisible_fraction",
+          min_covisible_fraction, "in (0, 1]");
+  require(max_view_angle_deg > 0.0 && max_view_angle_deg <= 180.0, "max_view_angle_deg",
+          max_view_angle_deg, "in (0, 180]");
+  require(max_shared_fraction >= 0.0 && max_shared_fraction <= 1.0, "max_shared_fraction",
+          max_shared_fraction, "in [0, 1]");
+  require.positive("max_merge_error_px", max_merge_error_px);
+  require(max_rounds >= 1, "max_rounds", max_rounds, ">= 1");
+}
+
 void PointInitialiserOptions::validate() const {
   undistort.validate();
+  loops.validate();
   klt.validate();
   features.validate();
   tracks.validate();
@@ -735,6 +750,191 @@ struct PointInitialiser::State {
   }
 
   // -------------------------------------------------------------------------------------------
+  // Loop matches (LoopMatchOptions).
+
+  // One end of a loop match: a keypoint, and the track that observes it or -1.
+  struct LoopEnd {
+    int frame = -1;
+    Eigen::Vector2d pixel;
+    int track = -1;
+  };
+  using LoopMatch = std::pair<LoopEnd, LoopEnd>;
+
+  // Whether two registered frames look like a loop: much of what `a` sees projects into `b`,
+  // little of it is tracked there.
+  bool isLoopCandidate(const Model& model, int a, int b) const {
+    const LoopMatchOptions& o = options.loops;
+    const Eigen::Vector3d centre_a = centreOf(*model.poses[a]);
+    const Eigen::Vector3d centre_b = centreOf(*model.poses[b]);
+    int seen = 0, covisible = 0, shared = 0;
+    for (int t : tracks.frame_tracks[a]) {
+      const int p = model.point_of_track[t];
+      if (p < 0) continue;
+      const MapPoint& point = model.points[p];
+      if (std::find(point.frames.begin(), point.frames.end(), a) == point.frames.end()) continue;
+      ++seen;
+      Eigen::Vector2d pixel;
+      if (!camera->project(*model.poses[b] * point.position, &pixel) || !camera->isInImage(pixel) ||
+          triangulationAngleDeg(centre_a, centre_b, point.position) > o.max_view_angle_deg)
+        continue;
+      ++covisible;
+      shared += std::find(point.frames.begin(), point.frames.end(), b) != point.frames.end();
+    }
+    return seen > 0 && covisible >= o.min_covisible_fraction * seen &&
+           shared <= o.max_shared_fraction * covisible;
+  }
+
+  std::vector<LoopMatch> findLoopMatches(const Model& model) {
+    std::vector<LoopMatch> found;
+    const std::vector<MatchingFrameFeatures>& frames = tracks.matching_frames;
+    for (std::size_t j = 0; j < frames.size(); ++j) {
+      for (std::size_t i = 0; i < j; ++i) {
+        const MatchingFrameFeatures& a = frames[i];
+        const MatchingFrameFeatures& b = frames[j];
+        if (!model.poses[a.frame] || !model.poses[b.frame] ||
+            tracks.matched_pairs.count({a.frame, b.frame}) ||
+            !isLoopCandidate(model, a.frame, b.frame))
+          continue;
+        ++out.loops.candidate_pairs;
+        const std::vector<FeatureMatch> matches = verifiedMatches(
+            matchFeatures(a.features, b.features, options.features),
+            options.tracks.verify_threshold_px, options.tracks.min_verified_matches);
+        out.loops.verified_pairs += !matches.empty();
+        for (const FeatureMatch& m : matches) {
+          const LoopEnd end_a{a.frame, m.pixel_a, a.track_of_keypoint[m.index_a]};
+          const LoopEnd end_b{b.frame, m.pixel_b, b.track_of_keypoint[m.index_b]};
+          if (end_a.track < 0 && end_b.track < 0) continue;
+          if (end_a.track == end_b.track) continue;
+          found.emplace_back(end_a, end_b);
+        }
+      }
+    }
+    out.loops.matches = static_cast<int>(found.size());
+    return found;
+  }
+
+  // The observations a loop end brings: its track's, or the keypoint alone.
+  std::vector<TrackObservation> observationsOf(const LoopEnd& end) const {
+    if (end.track >= 0) return tracks.tracks[end.track].observations;
+    return {{end.frame, end.pixel}};
+  }
+
+  // Both ends' observations by frame; nullopt when both observe one frame (a track holds one
+  // observation per frame).
+  std::optional<std::vector<TrackObservation>> joinedObservations(const LoopEnd& a,
+                                                                  const LoopEnd& b) const {
+    std::vector<TrackObservation> joined = observationsOf(a);
+    for (const TrackObservation& o : observationsOf(b)) {
+      const auto same_frame = [&o](const TrackObservation& j) { return j.frame == o.frame; };
+      if (std::any_of(joined.begin(), joined.end(), same_frame)) return std::nullopt;
+      joined.push_back(o);
+    }
+    std::sort(
+        joined.begin(), joined.end(),
+        [](const TrackObservation& x, const TrackObservation& y) { return x.frame < y.frame; });
+    return joined;
+  }
+
+  // The merged point: the points' mean weighted by their observations (COLMAP's merge).
+  static Eigen::Vector3d mergedPosition(const Model& model, std::initializer_list<int> points) {
+    Eigen::Vector3d weighted = Eigen::Vector3d::Zero();
+    double weight = 0.0;
+    for (int p : points) {
+      if (p < 0) continue;
+      const double observations = static_cast<double>(model.points[p].frames.size());
+      weighted += observations * model.points[p].position;
+      weight += observations;
+    }
+    return weighted / weight;
+  }
+
+  // The registered frames of `observations`, if `position` reprojects within the loop bound into
+  // every one of them.
+  std::optional<std::vector<int>> framesExplained(const Model& model,
+                                                  const std::vector<TrackObservation>& observations,
+                                                  const Eigen::Vector3d& position) const {
+    std::vector<int> frames;
+    for (const TrackObservation& o : observations) {
+      if (!model.poses[o.frame]) continue;
+      Eigen::Vector2d projected;
+      if (!camera->project(*model.poses[o.frame] * position, &projected) ||
+          (projected - o.pixel).norm() > options.loops.max_merge_error_px) {
+        return std::nullopt;
+      }
+      frames.push_back(o.frame);
+    }
+    return frames;
+  }
+
+  // Gives `from`'s observations (a track, or a lone keypoint when from.track < 0) to track `to`.
+  void moveObservations(const LoopEnd& from, int to, std::vector<TrackObservation> joined) {
+    for (const TrackObservation& o : observationsOf(from)) {
+      std::vector<int>& in_frame = tracks.frame_tracks[o.frame];
+      if (from.track >= 0) in_frame.erase(std::find(in_frame.begin(), in_frame.end(), from.track));
+      in_frame.insert(std::lower_bound(in_frame.begin(), in_frame.end(), to), to);
+    }
+    tracks.tracks[to].observations = std::move(joined);
+    if (from.track >= 0) tracks.tracks[from.track].observations.clear();
+  }
+
+  // Merges the two ends' tracks when one point explains every registered observation of both
+  // (see LoopMatchOptions); `alias` maps a merged-away track to the one that took it.
+  bool tryMerge(Model* model, LoopEnd a, LoopEnd b, std::vector<int>* alias) {
+    const auto resolve = [alias](int t) {
+      while (t >= 0 && (*alias)[t] != t) t = (*alias)[t];
+      return t;
+    };
+    a.track = resolve(a.track);
+    b.track = resolve(b.track);
+    if (a.track == b.track) return false;
+    if (a.track < 0) std::swap(a, b);  // `a` holds a track; `b` may be a lone keypoint.
+    const int pa = model->point_of_track[a.track];
+    const int pb = b.track >= 0 ? model->point_of_track[b.track] : -1;
+    if (pa < 0 && pb < 0) return false;
+    std::optional<std::vector<TrackObservation>> joined = joinedObservations(a, b);
+    if (!joined) return false;
+    const Eigen::Vector3d position = mergedPosition(*model, {pa, pb});
+    const std::optional<std::vector<int>> frames = framesExplained(*model, *joined, position);
+    if (!frames) return false;
+
+    moveObservations(b, a.track, std::move(*joined));
+    if (b.track >= 0) (*alias)[b.track] = a.track;
+    for (int p : {pa, pb}) {
+      if (p >= 0) model->removePoint(p);
+    }
+    model->addPoint(position, a.track, *frames);
+    return true;
+  }
+
+  // Merges the tracks that loop matches join, with a global BA after each round of merges.
+  void closeLoops(Model* model, int model_id) {
+    if (!options.loops.enabled) return;
+    const Clock::time_point start = Clock::now();
+    std::vector<LoopMatch> pending = findLoopMatches(*model);
+    std::vector<int> alias(tracks.tracks.size());
+    std::iota(alias.begin(), alias.end(), 0);
+    out.seconds.loops += secondsSince(start);
+    for (int round = 0; round < options.loops.max_rounds && !pending.empty(); ++round) {
+      const Clock::time_point round_start = Clock::now();
+      std::vector<LoopMatch> left;
+      int merged = 0;
+      for (const LoopMatch& m : pending) {
+        if (tryMerge(model, m.first, m.second, &alias)) {
+          ++merged;
+        } else {
+          left.push_back(m);
+        }
+      }
+      pending = std::move(left);
+      out.seconds.loops += secondsSince(round_start);
+      if (merged == 0) break;
+      out.loops.merges += merged;
+      ++out.loops.rounds;
+      globalRefinement(model, model_id);
+    }
+  }
+
+  // -------------------------------------------------------------------------------------------
   // Output.
 
   void writeResult(const Model& merged, const std::vector<Model>& models,
@@ -822,7 +1022,8 @@ struct PointInitialiser::State {
     std::vector<Model> models = buildModels();
     if (!models.empty()) {
       std::vector<int> model_of_frame(numFrames(), -1);
-      const Model merged = mergeModels(models, &model_of_frame);
+      Model merged = mergeModels(models, &model_of_frame);
+      closeLoops(&merged, model_of_frame[merged.pair.first]);
       writeResult(merged, models, model_of_frame);
     } else {
       writeResult(Model(numFrames(), 0), models, std::vector<int>(numFrames(), -1));

@@ -55,9 +55,49 @@ namespace curvesfm {
 //     or, with too few of those, by the poses of a frame both registered (scale: the ratio of
 //     the median depths of the points each sees in it); a model that shares neither is reported
 //     apart and its frames count as unregistered.
+//  7. Loop matches (LoopMatchOptions): pairs of matching frames that the merged model says see
+//     the same scene but that share few tracks are matched, and their matches merge tracks where
+//     one point explains both, with global BA after each round: what ties a trajectory's return
+//     to its start, which the matching window alone leaves to drift.
 //
 // Pixels: the images may be distorted; they are undistorted once (ImageUndistorter), and every
 // pixel of the result (point observations) is an undistorted pixel of undistortedCamera().
+
+/// Loop matches, once the models are built and merged: a trajectory that returns to a place it
+/// saw long before shares no track with its earlier frames (the matching window pairs only
+/// nearby frames), so nothing holds its scale and position to theirs. Pairs of matching frames
+/// that the reconstruction says see the same scene but share few tracks are matched (SIFT,
+/// F/H verification), and each verified match merges the two tracks it joins only where one
+/// point reprojects within max_merge_error_px into every registered frame of both (COLMAP's
+/// track merging): a wrong match that a fitted F lets through joins two scene points at
+/// different depths and fails this test. Global BA follows every round of merges, and the
+/// matches not merged yet are tried again on its poses.
+struct LoopMatchOptions {
+  /// Whether loop matches are searched.
+  bool enabled = true;
+  /// A pair of registered matching frames is a candidate when at least this fraction of the
+  /// points seen in the earlier frame project into the later one's image, in front of it
+  /// (unitless). In (0, 1].
+  double min_covisible_fraction = 0.3;
+  /// A point counts as seen by both only when their rays to it differ by at most this (deg):
+  /// a point projects into a camera on the other side of the scene too, but its appearance
+  /// changes beyond matching. Pavilion orbits its chair: without the limit 954 pairs are
+  /// candidates and 75 of them have verified matches (5.9 s of matching); 60 deg keeps 294 with
+  /// all 75 (2.4 s), 40 deg 184 with 69 and a worse fountain-P11 (2.52 against 2.43 mm;
+  /// docs/benchmarks.md, session 49). In (0, 180].
+  double max_view_angle_deg = 60.0;
+  /// ...and at most this fraction of those projecting points are already seen in the later
+  /// frame (unitless): the two frames see the same scene but their tracks do not say so.
+  /// In [0, 1].
+  double max_shared_fraction = 0.5;
+  /// A merged point must reproject within this distance into every registered frame of both
+  /// tracks (px; COLMAP's merge bound 4). Finite, > 0.
+  double max_merge_error_px = 8.0;
+  /// Most rounds of merges and global BA (count). >= 1.
+  int max_rounds = 3;
+  /// Throws InvalidOptions naming the first field outside its range.
+  void validate() const;
+};
 
 /// Thresholds of the incremental reconstruction (defaults: COLMAP's and ORB-SLAM's, see above).
 struct PointInitialiserOptions {
@@ -117,6 +157,7 @@ struct PointInitialiserOptions {
   /// Fewest tracks two models must both have triangulated to be merged by them, and fewest
   /// points each must see in a shared frame to be merged by its poses instead (count). >= 3.
   int min_merge_points = 20;
+  LoopMatchOptions loops;  ///< Loop matches after the models are merged.
   /// OpenCV threads while the tracks are built (count; 0: OpenCV's default, every core). One by
   /// default: issue 13 budgets tracking per core, and two threads gain about a quarter of the
   /// wall time of SIFT detection for half again its processor time. The command's --threads sets
@@ -181,10 +222,20 @@ struct InitialiserBundleAdjustment {
 /// Wall time of each stage (s).
 struct InitialiserTimes {
   double undistort = 0.0, klt = 0.0, matching = 0.0, pair_search = 0.0, registration = 0.0,
-         triangulation = 0.0, local_ba = 0.0, global_ba = 0.0, merge = 0.0, total = 0.0;
+         triangulation = 0.0, local_ba = 0.0, global_ba = 0.0, merge = 0.0, loops = 0.0,
+         total = 0.0;
   /// Undistortion and tracks per frame, scaled to a 640x480 frame by the pixel count (ms): the
   /// tracking budget of issue 13 (50 ms on one core, tracking_threads 1) in any image size.
   double tracksMsPerVgaFrame(int frames, int width, int height) const;
+};
+
+/// What the loop matches did.
+struct LoopMatchStats {
+  int candidate_pairs = 0;  ///< Pairs of matching frames matched as loop candidates.
+  int verified_pairs = 0;   ///< Of those, pairs whose matches passed the F/H verification.
+  int matches = 0;          ///< Verified matches that join two different tracks.
+  int merges = 0;           ///< Of those, merged (over all rounds).
+  int rounds = 0;           ///< Rounds of merges and global BA run.
 };
 
 /// What the initialiser made of the sequence.
@@ -197,6 +248,7 @@ struct PointInitialisation {
   std::pair<int, int> initial_pair = {-1, -1};  ///< Frames of the first model's pair.
   TwoViewGeometry initial_geometry;             ///< Its two-view geometry.
   int pairs_tried = 0;                          ///< Pair candidates evaluated, all models.
+  LoopMatchStats loops;                         ///< Loop matches (LoopMatchOptions).
   /// The gauge: map unit = median depth of the initial pair's points in its first frame.
   std::string scale_convention = "median depth of the initial pair's points = 1";
   /// The factor global BA applied to the camera's focal lengths (unitless; 1 unless

@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+#include <utility>
+#include <vector>
+
 #include "core/errors.h"
 #include "sim/planar_scene.h"
 #include "test/support/textures.h"
@@ -93,6 +97,31 @@ TEST(FeatureTracks, ShortSequenceMatchesEveryPairOfMatchingFrames) {
   // One frame too many for the bound: the window alone again.
   exhaustive.exhaustive_max_frames = 3;
   EXPECT_TRUE(build(frames, exhaustive).sharedTracks(0, 3).empty());
+}
+
+// The matching frames' descriptors stay available for loop matches, each keypoint with the track
+// that observes it at its pixel, and the pairs the window matched are listed.
+TEST(FeatureTracks, KeepMatchingFramesWithTheTrackOfEachKeypoint) {
+  const std::vector<int> frames = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 8, 7, 6};
+  const FeatureTracks tracks = build(frames);
+  std::vector<int> matching;
+  for (const MatchingFrameFeatures& m : tracks.matching_frames) matching.push_back(m.frame);
+  EXPECT_EQ(matching, (std::vector<int>{0, 5, 10, 12}));
+  const std::set<std::pair<int, int>> window = {{0, 5}, {0, 10}, {5, 10}, {5, 12}, {10, 12}};
+  EXPECT_EQ(tracks.matched_pairs, window);
+  for (const MatchingFrameFeatures& m : tracks.matching_frames) {
+    ASSERT_EQ(static_cast<int>(m.track_of_keypoint.size()), m.features.size());
+    int tracked = 0;
+    for (int k = 0; k < m.features.size(); ++k) {
+      const int t = m.track_of_keypoint[k];
+      if (t < 0) continue;
+      ++tracked;
+      ASSERT_NE(tracks.pixel(t, m.frame), nullptr);
+      EXPECT_LE((*tracks.pixel(t, m.frame) - m.features.pixels[k]).norm(),
+                FeatureTrackOptions{}.merge_radius_px);
+    }
+    EXPECT_GT(tracked, m.features.size() / 4) << "matching frame " << m.frame;
+  }
 }
 
 TEST(FeatureTracks, RejectsBadOptions) {

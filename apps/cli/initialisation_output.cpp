@@ -117,6 +117,17 @@ PointInitialisation initialiseSequence(const ImageSequence& sequence,
                 total, points, secondsSince(start));
     std::fflush(stdout);
   });
+  initialiser.setLoopProgress([start](int round, const LoopMatchStats& loops) {
+    if (round == 0) {
+      std::printf(
+          "init: loop matches: %d candidate pairs matched (%d verified), %d matches (%.1f s)\n",
+          loops.candidate_pairs, loops.verified_pairs, loops.matches, secondsSince(start));
+    } else {
+      std::printf("init: loop round %d: %d tracks merged so far, global BA done (%.1f s)\n", round,
+                  loops.merges, secondsSince(start));
+    }
+    std::fflush(stdout);
+  });
   return initialiser.finish();
 }
 

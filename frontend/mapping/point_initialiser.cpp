@@ -159,6 +159,7 @@ struct PointInitialiser::State {
   PointInitialisation out;
   int frames_added = 0;
   PointInitialiser::Progress progress;
+  PointInitialiser::LoopProgress loop_progress;
   double add_frame_seconds = 0.0;  // Undistortion and tracks, frame by frame.
   // OpenCV's thread count while tracking: set at the first frame, restored once the tracks are
   // built (switching it per frame would rebuild OpenCV's thread pool every time).
@@ -914,6 +915,7 @@ struct PointInitialiser::State {
     std::vector<int> alias(tracks.tracks.size());
     std::iota(alias.begin(), alias.end(), 0);
     out.seconds.loops += secondsSince(start);
+    if (loop_progress) loop_progress(0, out.loops);
     for (int round = 0; round < options.loops.max_rounds && !pending.empty(); ++round) {
       const Clock::time_point round_start = Clock::now();
       std::vector<LoopMatch> left;
@@ -931,6 +933,7 @@ struct PointInitialiser::State {
       out.loops.merges += merged;
       ++out.loops.rounds;
       globalRefinement(model, model_id);
+      if (loop_progress) loop_progress(out.loops.rounds, out.loops);
     }
   }
 
@@ -1056,5 +1059,9 @@ PointInitialisation PointInitialiser::finishAtPoses(
 const Camera& PointInitialiser::undistortedCamera() const { return *state_->camera; }
 
 void PointInitialiser::setProgress(Progress progress) { state_->progress = std::move(progress); }
+
+void PointInitialiser::setLoopProgress(LoopProgress progress) {
+  state_->loop_progress = std::move(progress);
+}
 
 }  // namespace curvesfm

@@ -287,6 +287,11 @@ class PointInitialiser {
   /// frames given, live points in it): a long reconstruction shows its progress.
   using Progress = std::function<void(int model, int registered, int frames, int points)>;
   void setProgress(Progress progress);
+  /// Called by finish() once the loop candidates are matched (round 0) and after each round of
+  /// merges and its global BA (round 1, 2, ...), with the counts so far: on long video the loop
+  /// matches take a while (the kitchen's 300 frames: about 30 s).
+  using LoopProgress = std::function<void(int round, const LoopMatchStats& so_far)>;
+  void setLoopProgress(LoopProgress progress);
 
  private:
   struct State;

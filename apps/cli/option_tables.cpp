@@ -853,14 +853,15 @@ void addLoopMatchOptions(OptionsTable* table, LoopMatchOptions* o, const OptionP
   table->group(o, "LoopMatchOptions", place.path, place.prefix, place.heading)
       .boolean("enabled", "enabled", &o->enabled,
                "Match frames that see the same scene without shared tracks, and merge tracks")
-      .number("min_covisible_fraction", "min-covisible-fraction", &o->min_covisible_fraction,
-              "A loop candidate: this fraction of one frame's points project into the other")
+      .number(
+          "min_covisible_fraction", "min-covisible-fraction", &o->min_covisible_fraction,
+          "A loop candidate: at least this fraction of one frame's points project into the other")
       .number("max_view_angle_deg", "max-view-angle", &o->max_view_angle_deg,
-              "...counting only points whose two rays differ by at most this (deg)")
+              "... counting only points whose two rays differ by at most this (deg)")
       .number("max_shared_fraction", "max-shared-fraction", &o->max_shared_fraction,
-              "...and at most this fraction of those are tracked there already")
+              "... and at most this fraction of those are tracked there already")
       .number("max_merge_error_px", "max-merge-error", &o->max_merge_error_px,
-              "A merged point reprojects within this into every frame of both tracks (px)")
+              "A merged point reprojects within this into every registered frame of both (px)")
       .number("max_rounds", "max-rounds", &o->max_rounds,
               "Most rounds of merges, each followed by global BA");
 }

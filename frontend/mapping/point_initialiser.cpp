@@ -54,7 +54,6 @@ void LoopMatchOptions::validate() const {
 
 void PointInitialiserOptions::validate() const {
   undistort.validate();
-  loops.validate();
   klt.validate();
   features.validate();
   tracks.validate();
@@ -63,6 +62,7 @@ void PointInitialiserOptions::validate() const {
   ba.validate();
   local_ba.validate();
   global_ba.validate();
+  loops.validate();
   const OptionCheck require("PointInitialiserOptions");
   require(pair_search_frames >= 1, "pair_search_frames", pair_search_frames, ">= 1");
   require(max_pair_gap >= 1, "max_pair_gap", max_pair_gap, ">= 1");
@@ -753,13 +753,46 @@ struct PointInitialiser::State {
   // -------------------------------------------------------------------------------------------
   // Loop matches (LoopMatchOptions).
 
-  // One end of a loop match: a keypoint, and the track that observes it or -1.
+  // One end of a loop match: keypoint `keypoint` of a matching frame, and the track that
+  // observes it or -1 (a lone keypoint).
   struct LoopEnd {
     int frame = -1;
+    int keypoint = -1;
     Eigen::Vector2d pixel;
     int track = -1;
   };
   using LoopMatch = std::pair<LoopEnd, LoopEnd>;
+
+  // Which track each loop end belongs to as merges proceed: a merged-away track points to the
+  // track that took it, and a lone keypoint that joined a track belongs to it from then on (so
+  // that a keypoint matched from two frames joins one track, not one each).
+  struct TrackMerges {
+    std::vector<int> alias;
+    std::map<std::pair<int, int>, int> track_of_lone_keypoint;  // By (frame, keypoint).
+
+    explicit TrackMerges(int tracks) : alias(tracks) { std::iota(alias.begin(), alias.end(), 0); }
+    LoopEnd resolve(LoopEnd end) const {
+      if (end.track < 0) {
+        const auto owner = track_of_lone_keypoint.find({end.frame, end.keypoint});
+        if (owner != track_of_lone_keypoint.end()) end.track = owner->second;
+      }
+      while (end.track >= 0 && alias[end.track] != end.track) end.track = alias[end.track];
+      return end;
+    }
+    void record(const LoopEnd& from, int to) {
+      if (from.track >= 0) {
+        alias[from.track] = to;
+      } else {
+        track_of_lone_keypoint[{from.frame, from.keypoint}] = to;
+      }
+    }
+  };
+
+  enum class MergeOutcome {
+    kMerged,
+    kNotYet,  // No point yet, or one that does not explain both: global BA may change that.
+    kNever,   // One track already, or both observe one frame: merges only make tracks longer.
+  };
 
   // Whether two registered frames look like a loop: much of what `a` sees projects into `b`,
   // little of it is tracked there.
@@ -802,8 +835,8 @@ struct PointInitialiser::State {
             options.tracks.verify_threshold_px, options.tracks.min_verified_matches);
         out.loops.verified_pairs += !matches.empty();
         for (const FeatureMatch& m : matches) {
-          const LoopEnd end_a{a.frame, m.pixel_a, a.track_of_keypoint[m.index_a]};
-          const LoopEnd end_b{b.frame, m.pixel_b, b.track_of_keypoint[m.index_b]};
+          const LoopEnd end_a{a.frame, m.index_a, m.pixel_a, a.track_of_keypoint[m.index_a]};
+          const LoopEnd end_b{b.frame, m.index_b, m.pixel_b, b.track_of_keypoint[m.index_b]};
           if (end_a.track < 0 && end_b.track < 0) continue;
           if (end_a.track == end_b.track) continue;
           found.emplace_back(end_a, end_b);
@@ -871,7 +904,12 @@ struct PointInitialiser::State {
   void moveObservations(const LoopEnd& from, int to, std::vector<TrackObservation> joined) {
     for (const TrackObservation& o : observationsOf(from)) {
       std::vector<int>& in_frame = tracks.frame_tracks[o.frame];
-      if (from.track >= 0) in_frame.erase(std::find(in_frame.begin(), in_frame.end(), from.track));
+      if (from.track >= 0) {
+        const auto listed = std::find(in_frame.begin(), in_frame.end(), from.track);
+        CURVESFM_CHECK(listed != in_frame.end())
+            << "track " << from.track << " is not listed in frame " << o.frame;
+        in_frame.erase(listed);
+      }
       in_frame.insert(std::lower_bound(in_frame.begin(), in_frame.end(), to), to);
     }
     tracks.tracks[to].observations = std::move(joined);
@@ -879,41 +917,41 @@ struct PointInitialiser::State {
   }
 
   // Merges the two ends' tracks when one point explains every registered observation of both
-  // (see LoopMatchOptions); `alias` maps a merged-away track to the one that took it.
-  bool tryMerge(Model* model, LoopEnd a, LoopEnd b, std::vector<int>* alias) {
-    const auto resolve = [alias](int t) {
-      while (t >= 0 && (*alias)[t] != t) t = (*alias)[t];
-      return t;
-    };
-    a.track = resolve(a.track);
-    b.track = resolve(b.track);
-    if (a.track == b.track) return false;
+  // (see LoopMatchOptions).
+  MergeOutcome tryMerge(Model* model, const LoopMatch& match, TrackMerges* merges) {
+    LoopEnd a = merges->resolve(match.first);
+    LoopEnd b = merges->resolve(match.second);
+    if (a.track == b.track) return MergeOutcome::kNever;
     if (a.track < 0) std::swap(a, b);  // `a` holds a track; `b` may be a lone keypoint.
+    std::optional<std::vector<TrackObservation>> joined = joinedObservations(a, b);
+    if (!joined) return MergeOutcome::kNever;
     const int pa = model->point_of_track[a.track];
     const int pb = b.track >= 0 ? model->point_of_track[b.track] : -1;
-    if (pa < 0 && pb < 0) return false;
-    std::optional<std::vector<TrackObservation>> joined = joinedObservations(a, b);
-    if (!joined) return false;
+    if (pa < 0 && pb < 0) return MergeOutcome::kNotYet;
     const Eigen::Vector3d position = mergedPosition(*model, {pa, pb});
     const std::optional<std::vector<int>> frames = framesExplained(*model, *joined, position);
-    if (!frames) return false;
+    if (!frames) return MergeOutcome::kNotYet;
 
     moveObservations(b, a.track, std::move(*joined));
-    if (b.track >= 0) (*alias)[b.track] = a.track;
+    merges->record(b, a.track);
     for (int p : {pa, pb}) {
       if (p >= 0) model->removePoint(p);
     }
     model->addPoint(position, a.track, *frames);
-    return true;
+    return MergeOutcome::kMerged;
   }
 
-  // Merges the tracks that loop matches join, with a global BA after each round of merges.
+  // Merges the tracks that loop matches join, with a global BA after each round of merges. The
+  // matching frames' descriptors are released after: nothing else needs them.
   void closeLoops(Model* model, int model_id) {
-    if (!options.loops.enabled) return;
+    if (!options.loops.enabled) {
+      releaseMatchingFrames();
+      return;
+    }
     const Clock::time_point start = Clock::now();
     std::vector<LoopMatch> pending = findLoopMatches(*model);
-    std::vector<int> alias(tracks.tracks.size());
-    std::iota(alias.begin(), alias.end(), 0);
+    releaseMatchingFrames();
+    TrackMerges merges(static_cast<int>(tracks.tracks.size()));
     out.seconds.loops += secondsSince(start);
     if (loop_progress) loop_progress(0, out.loops);
     for (int round = 0; round < options.loops.max_rounds && !pending.empty(); ++round) {
@@ -921,11 +959,9 @@ struct PointInitialiser::State {
       std::vector<LoopMatch> left;
       int merged = 0;
       for (const LoopMatch& m : pending) {
-        if (tryMerge(model, m.first, m.second, &alias)) {
-          ++merged;
-        } else {
-          left.push_back(m);
-        }
+        const MergeOutcome outcome = tryMerge(model, m, &merges);
+        merged += outcome == MergeOutcome::kMerged;
+        if (outcome == MergeOutcome::kNotYet) left.push_back(m);
       }
       pending = std::move(left);
       out.seconds.loops += secondsSince(round_start);
@@ -935,6 +971,10 @@ struct PointInitialiser::State {
       globalRefinement(model, model_id);
       if (loop_progress) loop_progress(out.loops.rounds, out.loops);
     }
+  }
+
+  void releaseMatchingFrames() {
+    std::vector<MatchingFrameFeatures>().swap(tracks.matching_frames);
   }
 
   // -------------------------------------------------------------------------------------------
@@ -1004,6 +1044,7 @@ struct PointInitialiser::State {
         << "finishAtPoses: " << cam_from_world.size() << " poses for " << frames_added << " frames";
     const Clock::time_point start = Clock::now();
     buildTracks();
+    releaseMatchingFrames();
     Model model(numFrames(), static_cast<int>(tracks.tracks.size()));
     for (int f = 0; f < numFrames(); ++f) {
       if (cam_from_world[f]) model.registerFrame(f, *cam_from_world[f]);

@@ -222,8 +222,10 @@ struct InitialiserBundleAdjustment {
 /// Wall time of each stage (s).
 struct InitialiserTimes {
   double undistort = 0.0, klt = 0.0, matching = 0.0, pair_search = 0.0, registration = 0.0,
-         triangulation = 0.0, local_ba = 0.0, global_ba = 0.0, merge = 0.0, loops = 0.0,
-         total = 0.0;
+         triangulation = 0.0, local_ba = 0.0, global_ba = 0.0, merge = 0.0, total = 0.0;
+  /// Loop matches: finding and matching the candidate pairs and merging tracks (the global BA and
+  /// re-triangulation after each round count in global_ba and triangulation).
+  double loops = 0.0;
   /// Undistortion and tracks per frame, scaled to a 640x480 frame by the pixel count (ms): the
   /// tracking budget of issue 13 (50 ms on one core, tracking_threads 1) in any image size.
   double tracksMsPerVgaFrame(int frames, int width, int height) const;
@@ -233,7 +235,9 @@ struct InitialiserTimes {
 struct LoopMatchStats {
   int candidate_pairs = 0;  ///< Pairs of matching frames matched as loop candidates.
   int verified_pairs = 0;   ///< Of those, pairs whose matches passed the F/H verification.
-  int matches = 0;          ///< Verified matches that join two different tracks.
+  /// Verified matches with a track at one end at least and not the same track at both (a pair
+  /// of tracks may be joined by several).
+  int matches = 0;
   int merges = 0;           ///< Of those, merged (over all rounds).
   int rounds = 0;           ///< Rounds of merges and global BA run.
 };

@@ -5,9 +5,6 @@
 
 namespace curvesfm::testing {
 
-/// A 640x480 grey texture of many small filled rectangles and discs in random grey levels (fixed
-/// seed) on a mid-grey ground: corners and blobs everywhere, so that every grid cell of a view has
-/// something to track and SIFT and ORB find features all over it.
 /// Draws `count` filled rectangles with sides in [min_side, max_side) px at random places of
 /// `texture`, in random grey levels.
 inline void drawRandomRectangles(cv::Mat* texture, cv::RNG* rng, int count, int min_side,
@@ -20,6 +17,9 @@ inline void drawRandomRectangles(cv::Mat* texture, cv::RNG* rng, int count, int 
   }
 }
 
+/// A 640x480 grey texture of many small filled rectangles and discs in random grey levels (fixed
+/// seed) on a mid-grey ground: corners and blobs everywhere, so that every grid cell of a view has
+/// something to track and SIFT and ORB find features all over it.
 inline cv::Mat denseTexture() {
   cv::Mat texture(480, 640, CV_8UC1, cv::Scalar(128));
   cv::RNG rng(11);

@@ -314,7 +314,7 @@ struct FeatureTrackBuilder::State {
     out.num_frames = frames;
     out.frame_tracks.resize(frames);
     out.frames = stats;
-    out.matched_pairs = matched_pairs;
+    out.matched_pairs = std::move(matched_pairs);
     std::vector<int> kept_index(joined.size(), -1);
     for (std::size_t j = 0; j < joined.size(); ++j) {
       FeatureTrack& track = joined[j];

@@ -115,6 +115,9 @@ struct MapPoint {
   int track = -1;
   std::vector<int> frames;
   bool alive() const { return track >= 0; }
+  bool seenIn(int frame) const {
+    return std::find(frames.begin(), frames.end(), frame) != frames.end();
+  }
 };
 
 // One sub-model of the reconstruction.
@@ -184,9 +187,16 @@ struct PointInitialiser::State {
 
   // Whether `point` lies in front of the frame and reprojects within the map's bound.
   bool reprojects(const Model& model, int frame, int track, const Eigen::Vector3d& point) const {
+    return reprojectsWithin(model, frame, pixelOf(track, frame), point,
+                            options.max_reprojection_error_px);
+  }
+
+  // Whether `point` lies in front of the frame and reprojects within `bound_px` of `pixel`.
+  bool reprojectsWithin(const Model& model, int frame, const Eigen::Vector2d& pixel,
+                        const Eigen::Vector3d& point, double bound_px) const {
     Eigen::Vector2d projected;
     if (!camera->project(*model.poses[frame] * point, &projected)) return false;
-    return (projected - pixelOf(track, frame)).norm() <= options.max_reprojection_error_px;
+    return (projected - pixel).norm() <= bound_px;
   }
 
   // The widest ray angle among (at most 8 evenly spread) frames: the gate needs the baseline the
@@ -626,7 +636,7 @@ struct PointInitialiser::State {
   std::vector<double> depthsIn(const Model& model, int frame) const {
     std::vector<double> depths;
     for (const MapPoint& p : model.points) {
-      if (p.alive() && std::find(p.frames.begin(), p.frames.end(), frame) != p.frames.end()) {
+      if (p.alive() && p.seenIn(frame)) {
         depths.push_back((*model.poses[frame] * p.position).z());
       }
     }
@@ -714,8 +724,7 @@ struct PointInitialiser::State {
         // Shared: the observations of frames the target took from the source join its point.
         MapPoint& q = target->points[target->point_of_track[p.track]];
         for (int f : p.frames) {
-          if (std::find(q.frames.begin(), q.frames.end(), f) == q.frames.end())
-            q.frames.push_back(f);
+          if (!q.seenIn(f)) q.frames.push_back(f);
         }
         continue;
       }
@@ -805,14 +814,14 @@ struct PointInitialiser::State {
       const int p = model.point_of_track[t];
       if (p < 0) continue;
       const MapPoint& point = model.points[p];
-      if (std::find(point.frames.begin(), point.frames.end(), a) == point.frames.end()) continue;
+      if (!point.seenIn(a)) continue;
       ++seen;
       Eigen::Vector2d pixel;
       if (!camera->project(*model.poses[b] * point.position, &pixel) || !camera->isInImage(pixel) ||
           triangulationAngleDeg(centre_a, centre_b, point.position) > o.max_view_angle_deg)
         continue;
       ++covisible;
-      shared += std::find(point.frames.begin(), point.frames.end(), b) != point.frames.end();
+      shared += point.seenIn(b);
     }
     return seen > 0 && covisible >= o.min_covisible_fraction * seen &&
            shared <= o.max_shared_fraction * covisible;
@@ -890,11 +899,8 @@ struct PointInitialiser::State {
     std::vector<int> frames;
     for (const TrackObservation& o : observations) {
       if (!model.poses[o.frame]) continue;
-      Eigen::Vector2d projected;
-      if (!camera->project(*model.poses[o.frame] * position, &projected) ||
-          (projected - o.pixel).norm() > options.loops.max_merge_error_px) {
+      if (!reprojectsWithin(model, o.frame, o.pixel, position, options.loops.max_merge_error_px))
         return std::nullopt;
-      }
       frames.push_back(o.frame);
     }
     return frames;

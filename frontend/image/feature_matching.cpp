@@ -49,9 +49,38 @@ cv::Mat resizedForDetection(const cv::Mat& grey, double scale) {
   return resized;
 }
 
+constexpr float kOrbScaleFactor = 1.2f;  // OpenCV's default, spelled out for orbPixel.
+
 cv::Ptr<cv::Feature2D> makeDetector(const FeatureMatchingOptions& o) {
-  if (o.kind == FeatureKind::kOrb) return cv::ORB::create(o.max_features);
+  if (o.kind == FeatureKind::kOrb) return cv::ORB::create(o.max_features, kOrbScaleFactor);
   return cv::SIFT::create(o.max_features);
+}
+
+// OpenCV 4.6's SIFT starts its scale space at the image doubled by a linear resize, which puts
+// the doubled image's pixel u at u / 2 - 0.25 of the image, and reports u / 2: every keypoint lies
+// 0.25 px right of and below its feature, at every octave (OpenCV issue 23123; the keypoints of
+// the image turned by 180 deg, mapped back, lie 0.5 px from the image's own along each axis:
+// test/frontend/image/feature_matching_test.cpp).
+// Uncorrected, SIFT's observations disagree with KLT's within one track, and on stills the
+// cameras turn to absorb the shift.
+constexpr double kSiftDoublingBiasPx = 0.25;
+
+// ORB scales a keypoint of pyramid level l by 1.2^l, but the level is the image resized to
+// round(size / 1.2^l) pixels, whose pixel p lies at (p + 0.5) size / level_size - 0.5 of the image:
+// up to a few tenths of a pixel apart at the coarser levels.
+Eigen::Vector2d orbPixel(const cv::KeyPoint& k, const cv::Size& image_size) {
+  const float level_scale = std::pow(kOrbScaleFactor, static_cast<float>(k.octave));
+  const Eigen::Array2d level_pixel(k.pt.x / level_scale, k.pt.y / level_scale);
+  const Eigen::Array2d level_size(cvRound(image_size.width / level_scale),
+                                  cvRound(image_size.height / level_scale));
+  const Eigen::Array2d size(image_size.width, image_size.height);
+  return (level_pixel + 0.5) * size / level_size - 0.5;
+}
+
+// The keypoint's position in the image it was detected in, pixel centres at integers.
+Eigen::Vector2d keypointPixel(const cv::KeyPoint& k, FeatureKind kind, const cv::Size& image_size) {
+  if (kind == FeatureKind::kOrb) return orbPixel(k, image_size);
+  return Eigen::Vector2d(k.pt.x - kSiftDoublingBiasPx, k.pt.y - kSiftDoublingBiasPx);
 }
 
 // Strongest first, ties broken by position, size and angle: a total order on distinct keypoints,
@@ -202,7 +231,8 @@ FeatureSet detectFeatures(const cv::Mat& image, const FeatureMatchingOptions& op
   for (std::size_t row = 0; row < order.size(); ++row) {
     const cv::KeyPoint& k = keypoints[static_cast<std::size_t>(order[row])];
     // Pixel centres at integers in both images: x = (x' + 0.5) / s - 0.5.
-    set.pixels.push_back((Eigen::Vector2d(k.pt.x, k.pt.y).array() + 0.5) / scale - 0.5);
+    const Eigen::Vector2d detected = keypointPixel(k, options.kind, grey.size());
+    set.pixels.push_back((detected.array() + 0.5) / scale - 0.5);
     descriptors.row(order[row]).copyTo(set.descriptors.row(static_cast<int>(row)));
   }
   return set;

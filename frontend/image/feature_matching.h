@@ -72,7 +72,9 @@ struct FeatureMatchingOptions {
 
 /// The features of one image: keypoint i has descriptor row i.
 struct FeatureSet {
-  std::vector<Eigen::Vector2d> pixels;  ///< Keypoint positions (px).
+  /// Keypoint positions (px, pixel centres at integers), corrected for where OpenCV's detectors
+  /// put them off their features (SIFT: 0.25 px right and down; ORB: its coarser levels).
+  std::vector<Eigen::Vector2d> pixels;
   /// One row per keypoint: CV_32F with 128 columns (SIFT) or CV_8U with 32 columns (ORB); empty
   /// when no feature was found.
   cv::Mat descriptors;

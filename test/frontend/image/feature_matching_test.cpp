@@ -118,6 +118,53 @@ TEST(FeatureMatching, KeypointsDetectedOnASmallerImageComeBackInFullSizePixels) 
   EXPECT_THROW(detectFeatures(scene().images[0], options), InvalidOptions);
 }
 
+// Half the mean offset between each keypoint of the dense texture and the nearest keypoint of the
+// texture turned by 180 deg, mapped back (within 1 px): the detector's bias. A detector without
+// one finds a feature at the same place in both images; OpenCV's SIFT alone puts both 0.25 px
+// right of and below it, so the two lie 0.5 px apart along each axis.
+Eigen::Vector2d detectorBias(const FeatureMatchingOptions& options, int* pairs) {
+  const cv::Mat image = testing::denseTexture();
+  cv::Mat turned;
+  cv::flip(image, turned, -1);
+  const FeatureSet a = detectFeatures(image, options);
+  const FeatureSet b = detectFeatures(turned, options);
+  const Eigen::Vector2d last_pixel(image.cols - 1, image.rows - 1);
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  *pairs = 0;
+  for (const Eigen::Vector2d& pixel : a.pixels) {
+    double nearest = 1.0;
+    Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& turned_pixel : b.pixels) {
+      const Eigen::Vector2d back = last_pixel - turned_pixel;
+      if ((pixel - back).norm() < nearest) {
+        nearest = (pixel - back).norm();
+        offset = pixel - back;
+      }
+    }
+    if (nearest < 1.0) {
+      sum += offset;
+      ++*pairs;
+    }
+  }
+  return sum / std::max(1, *pairs) / 2.0;
+}
+
+TEST(FeatureMatching, KeypointsLieWhereTheTurnedImagePutsThem) {
+  for (const FeatureKind kind : {FeatureKind::kSift, FeatureKind::kOrb}) {
+    for (const double detection_scale : {1.0, 0.5}) {
+      FeatureMatchingOptions options;
+      options.kind = kind;
+      options.detection_scale = detection_scale;
+      int pairs = 0;
+      const Eigen::Vector2d bias = detectorBias(options, &pairs);
+      std::cout << toString(kind) << " at scale " << detection_scale << ": " << pairs
+                << " keypoints found in both, bias " << bias.transpose() << " px\n";
+      EXPECT_GT(pairs, 200) << toString(kind) << " at scale " << detection_scale;
+      EXPECT_LT(bias.cwiseAbs().maxCoeff(), 0.03) << toString(kind) << " at " << detection_scale;
+    }
+  }
+}
+
 TEST(FeatureMatching, MutualCheckAndRatioTestRemoveMatches) {
   const PlanarScene& s = scene();
   FeatureMatchingOptions options;

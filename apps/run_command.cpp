@@ -966,8 +966,9 @@ RunInput RunCommand::loadInput() const {
                   input.sequence.images.size());
       input.initialisation = triangulateAtPoses(input.sequence, input.frames, initialiser_);
       input.sightings = sightingsOfFrames(input.sequence, input.frames, *input.initialisation);
-      std::printf("run: %zu points from %d tracks at the given poses\n",
-                  input.initialisation->points.size(), input.initialisation->num_tracks);
+      std::printf("run: %zu points from %d tracks at the given poses; %s\n",
+                  input.initialisation->points.size(), input.initialisation->num_tracks,
+                  reprojectionLine(input.initialisation->reprojection).c_str());
     }
     return input;
   }

@@ -219,6 +219,14 @@ void writeInitialisedPoints(const std::string& path, const PointInitialisation& 
   writePointsPly(path, points);
 }
 
+std::string reprojectionLine(const ReprojectionSummary& r) {
+  char text[200];
+  std::snprintf(text, sizeof(text),
+                "%d observations reproject with rms %.3f px, mean residual (%.3f, %.3f) px",
+                r.observations, r.rms_px, r.mean_px.x(), r.mean_px.y());
+  return text;
+}
+
 nlohmann::json initialisationToJson(const ImageSequence& sequence,
                                     const PointInitialisation& result) {
   nlohmann::json frames = nlohmann::json::array();
@@ -257,6 +265,10 @@ nlohmann::json initialisationToJson(const ImageSequence& sequence,
             {"matches", result.loops.matches},
             {"merges", result.loops.merges},
             {"rounds", result.loops.rounds}}},
+          {"reprojection",
+           {{"observations", result.reprojection.observations},
+            {"mean_px", {result.reprojection.mean_px.x(), result.reprojection.mean_px.y()}},
+            {"rms_px", result.reprojection.rms_px}}},
           {"scale_convention", result.scale_convention},
           {"focal_scale", result.focal_scale},
           {"initial_pair",
@@ -292,6 +304,7 @@ nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
       "init: %d of %d frames registered (%d models, %d merged), %zu points from %d tracks\n",
       result.registeredFrames(), frames, result.models, result.merged_models, result.points.size(),
       result.num_tracks);
+  std::printf("init: %s\n", reprojectionLine(result.reprojection).c_str());
   std::map<std::string, std::vector<int>> unregistered;
   for (int i = 0; i < frames; ++i) {
     const InitialisedFrame& f = result.frames[i];

@@ -54,9 +54,13 @@ void writeInitialisedPoints(const std::string& path, const PointInitialisation& 
 /// A camera's intrinsics and image size as report.json gives them.
 nlohmann::json cameraToJson(const Camera& camera);
 
-/// The report.json part of the initialiser: counts, the scale convention, the initial pair, per
-/// frame its registration (status, reason, correspondences, inliers), every BA's summary and the
-/// per-stage times.
+/// "N observations reproject with rms R px, mean residual (x, y) px": the summary line of a
+/// ReprojectionSummary.
+std::string reprojectionLine(const ReprojectionSummary& reprojection);
+
+/// The report.json part of the initialiser: counts, the points' reprojection, the scale
+/// convention, the initial pair, per frame its registration (status, reason, correspondences,
+/// inliers), every BA's summary and the per-stage times.
 nlohmann::json initialisationToJson(const ImageSequence& sequence,
                                     const PointInitialisation& result);
 

@@ -1062,6 +1062,7 @@ struct PointInitialiser::State {
     out.models = out.merged_models = model.registered() > 0 ? 1 : 0;
     out.scale_convention = "the given poses' unit";
     writeResult(model, {model}, std::vector<int>(numFrames(), 0));
+    out.reprojection = reprojectionSummary(*camera, out);
     out.seconds.total = add_frame_seconds + secondsSince(start);
     return std::move(out);
   }
@@ -1078,10 +1079,32 @@ struct PointInitialiser::State {
     } else {
       writeResult(Model(numFrames(), 0), models, std::vector<int>(numFrames(), -1));
     }
+    out.reprojection = reprojectionSummary(*camera, out);
     out.seconds.total = add_frame_seconds + secondsSince(start);
     return std::move(out);
   }
 };
+
+ReprojectionSummary reprojectionSummary(const Camera& camera, const PointInitialisation& result) {
+  ReprojectionSummary summary;
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  double squares = 0.0;
+  for (const InitialisedPoint& point : result.points) {
+    for (const TrackObservation& o : point.observations) {
+      const std::optional<Pose3>& pose = result.frames[o.frame].cam_from_world;
+      Eigen::Vector2d projected;
+      if (!pose || !camera.project(*pose * point.position, &projected)) continue;
+      const Eigen::Vector2d residual = o.pixel - projected;
+      sum += residual;
+      squares += residual.squaredNorm();
+      ++summary.observations;
+    }
+  }
+  if (summary.observations == 0) return summary;
+  summary.mean_px = sum / summary.observations;
+  summary.rms_px = std::sqrt(squares / summary.observations);
+  return summary;
+}
 
 double InitialiserTimes::tracksMsPerVgaFrame(int frames, int width, int height) const {
   if (frames <= 0 || width <= 0 || height <= 0) return 0.0;

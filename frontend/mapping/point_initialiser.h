@@ -211,6 +211,19 @@ struct InitialisedPoint {
   std::vector<TrackObservation> observations;
 };
 
+/// How a map's points reproject into the frames that observe them: residual = observed pixel -
+/// projected pixel (undistorted pixels). At the initialiser's own poses it is what BA left; at
+/// given poses it says how well those poses and the camera agree with the images: Pavilion's
+/// tracks reproject with rms 0.79 px at its exact poses and 1.84 px at the benches' truth + noise
+/// start (seed 1), templeRing's 0.94 and 2.09 px. The mean stays near zero even where every view
+/// is off by one shift: the points triangulated at the poses absorb it (half a pixel more on the
+/// principal point moved Pavilion's mean by 0.01 px, its rms by 0.001 px).
+struct ReprojectionSummary {
+  int observations = 0;                               ///< In front of their cameras.
+  Eigen::Vector2d mean_px = Eigen::Vector2d::Zero();  ///< Mean residual (px).
+  double rms_px = 0.0;                                ///< Root mean square of its length (px).
+};
+
 /// One bundle adjustment the initialiser ran.
 struct InitialiserBundleAdjustment {
   std::string scope;  ///< "two_view", "local" or "global".
@@ -260,11 +273,17 @@ struct PointInitialisation {
   double focal_scale = 1.0;
   std::vector<InitialiserBundleAdjustment> bundle_adjustments;
   std::vector<FeatureTrackFrameStats> track_stats;  ///< Per frame.
+  /// The points' residuals in the registered frames, at the poses returned.
+  ReprojectionSummary reprojection;
   InitialiserTimes seconds;
   int registeredFrames() const;
   /// Why nothing could be reconstructed; empty when a model exists.
   std::string failure;
 };
+
+/// The residuals of `result`'s points in its posed frames, projected by `camera` (the undistorted
+/// camera the pixels refer to).
+ReprojectionSummary reprojectionSummary(const Camera& camera, const PointInitialisation& result);
 
 /// Runs the initialiser over a sequence: feed every frame in order, then finish(). Not
 /// thread-safe.

@@ -304,7 +304,9 @@ nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
       "init: %d of %d frames registered (%d models, %d merged), %zu points from %d tracks\n",
       result.registeredFrames(), frames, result.models, result.merged_models, result.points.size(),
       result.num_tracks);
-  std::printf("init: %s\n", reprojectionLine(result.reprojection).c_str());
+  if (result.reprojection.observations > 0) {
+    std::printf("init: %s\n", reprojectionLine(result.reprojection).c_str());
+  }
   std::map<std::string, std::vector<int>> unregistered;
   for (int i = 0; i < frames; ++i) {
     const InitialisedFrame& f = result.frames[i];

@@ -966,9 +966,11 @@ RunInput RunCommand::loadInput() const {
                   input.sequence.images.size());
       input.initialisation = triangulateAtPoses(input.sequence, input.frames, initialiser_);
       input.sightings = sightingsOfFrames(input.sequence, input.frames, *input.initialisation);
-      std::printf("run: %zu points from %d tracks at the given poses; %s\n",
+      const ReprojectionSummary& reprojection = input.initialisation->reprojection;
+      std::printf("run: %zu points from %d tracks at the given poses%s%s\n",
                   input.initialisation->points.size(), input.initialisation->num_tracks,
-                  reprojectionLine(input.initialisation->reprojection).c_str());
+                  reprojection.observations > 0 ? "; " : "",
+                  reprojection.observations > 0 ? reprojectionLine(reprojection).c_str() : "");
     }
     return input;
   }

@@ -67,12 +67,15 @@ constexpr double kSiftDoublingBiasPx = 0.25;
 
 // ORB scales a keypoint of pyramid level l by 1.2^l, but the level is the image resized to
 // round(size / 1.2^l) pixels, whose pixel p lies at (p + 0.5) size / level_size - 0.5 of the image:
-// up to a few tenths of a pixel apart at the coarser levels.
+// at 640 px, 0.5 px off at level 1 and 1-2 px at the coarsest levels. The arithmetic is OpenCV
+// 4.6's own (a float scale from a double power, sizes rounded from size * (1 / scale)), so that
+// the level sizes agree where round(size / scale) would tie differently (513 px at level 1).
 Eigen::Vector2d orbPixel(const cv::KeyPoint& k, const cv::Size& image_size) {
-  const float level_scale = std::pow(kOrbScaleFactor, static_cast<float>(k.octave));
+  const float level_scale = static_cast<float>(std::pow(double{kOrbScaleFactor}, k.octave));
+  const float inverse_scale = 1.0f / level_scale;
   const Eigen::Array2d level_pixel(k.pt.x / level_scale, k.pt.y / level_scale);
-  const Eigen::Array2d level_size(cvRound(image_size.width / level_scale),
-                                  cvRound(image_size.height / level_scale));
+  const Eigen::Array2d level_size(cvRound(image_size.width * inverse_scale),
+                                  cvRound(image_size.height * inverse_scale));
   const Eigen::Array2d size(image_size.width, image_size.height);
   return (level_pixel + 0.5) * size / level_size - 0.5;
 }

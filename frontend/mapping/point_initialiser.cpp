@@ -1091,6 +1091,8 @@ ReprojectionSummary reprojectionSummary(const Camera& camera, const PointInitial
   double squares = 0.0;
   for (const InitialisedPoint& point : result.points) {
     for (const TrackObservation& o : point.observations) {
+      CURVESFM_CHECK(o.frame >= 0 && o.frame < static_cast<int>(result.frames.size()))
+          << "an observation in frame " << o.frame << " of " << result.frames.size();
       const std::optional<Pose3>& pose = result.frames[o.frame].cam_from_world;
       Eigen::Vector2d projected;
       if (!pose || !camera.project(*pose * point.position, &projected)) continue;

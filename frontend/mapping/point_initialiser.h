@@ -213,11 +213,10 @@ struct InitialisedPoint {
 
 /// How a map's points reproject into the frames that observe them: residual = observed pixel -
 /// projected pixel (undistorted pixels). At the initialiser's own poses it is what BA left; at
-/// given poses it says how well those poses and the camera agree with the images: Pavilion's
-/// tracks reproject with rms 0.79 px at its exact poses and 1.84 px at the benches' truth + noise
-/// start (seed 1), templeRing's 0.94 and 2.09 px. The mean stays near zero even where every view
-/// is off by one shift: the points triangulated at the poses absorb it (half a pixel more on the
-/// principal point moved Pavilion's mean by 0.01 px, its rms by 0.001 px).
+/// given poses it says how well those poses and the camera agree with the images (a start off by
+/// a few pixels per view more than doubles the rms; docs/benchmarks.md, session 50). The mean
+/// stays near zero even where every view is off by one shift: the points triangulated at the
+/// poses absorb most of it.
 struct ReprojectionSummary {
   int observations = 0;                               ///< In front of their cameras.
   Eigen::Vector2d mean_px = Eigen::Vector2d::Zero();  ///< Mean residual (px).

@@ -118,12 +118,14 @@ TEST(FeatureMatching, KeypointsDetectedOnASmallerImageComeBackInFullSizePixels) 
   EXPECT_THROW(detectFeatures(scene().images[0], options), InvalidOptions);
 }
 
-// Half the mean offset between each keypoint of the dense texture and the nearest keypoint of the
-// texture turned by 180 deg, mapped back (within 1 px): the detector's bias. A detector without
-// one finds a feature at the same place in both images; OpenCV's SIFT alone puts both 0.25 px
-// right of and below it, so the two lie 0.5 px apart along each axis.
-Eigen::Vector2d detectorBias(const FeatureMatchingOptions& options, int* pairs) {
-  const cv::Mat image = testing::denseTexture();
+// Half the mean offset between each keypoint of `image` and the nearest keypoint of the image
+// turned by 180 deg, mapped back (within 1 px): the detector's bias. A detector without one finds
+// a feature at the same place in both images; OpenCV's SIFT alone puts both 0.25 px right of and
+// below it, so the two lie 0.5 px apart along each axis. (An error that scales positions about the
+// image centre cancels in the mean; one that scales them about the corner, as a wrong pyramid
+// level size does, does not: the ORB case at an odd size checks that.)
+Eigen::Vector2d detectorBias(const cv::Mat& image, const FeatureMatchingOptions& options,
+                             int* pairs) {
   cv::Mat turned;
   cv::flip(image, turned, -1);
   const FeatureSet a = detectFeatures(image, options);
@@ -150,19 +152,34 @@ Eigen::Vector2d detectorBias(const FeatureMatchingOptions& options, int* pairs) 
 }
 
 TEST(FeatureMatching, KeypointsLieWhereTheTurnedImagePutsThem) {
+  const cv::Mat texture = testing::denseTexture();
   for (const FeatureKind kind : {FeatureKind::kSift, FeatureKind::kOrb}) {
     for (const double detection_scale : {1.0, 0.5}) {
       FeatureMatchingOptions options;
       options.kind = kind;
       options.detection_scale = detection_scale;
       int pairs = 0;
-      const Eigen::Vector2d bias = detectorBias(options, &pairs);
+      const Eigen::Vector2d bias = detectorBias(texture, options, &pairs);
       std::cout << toString(kind) << " at scale " << detection_scale << ": " << pairs
                 << " keypoints found in both, bias " << bias.transpose() << " px\n";
       EXPECT_GT(pairs, 200) << toString(kind) << " at scale " << detection_scale;
       EXPECT_LT(bias.cwiseAbs().maxCoeff(), 0.03) << toString(kind) << " at " << detection_scale;
     }
   }
+}
+
+TEST(FeatureMatching, OrbKeypointsLieWhereTheTurnedImagePutsThemAtAnOddSize) {
+  // 513 x 465 px: OpenCV's level 1 is 428 x 388 px, where round(513 / 1.2) in float gives 427,
+  // which would put that level's keypoints 1.2 px from their turned twins: beyond the pairing
+  // distance, so they would go missing from the pairs rather than show in the bias. ORB's
+  // detection is exactly symmetric under the turn, so every keypoint must find its twin.
+  const cv::Mat image = testing::denseTexture()(cv::Rect(0, 0, 513, 465)).clone();
+  FeatureMatchingOptions options;
+  options.kind = FeatureKind::kOrb;
+  int pairs = 0;
+  const Eigen::Vector2d bias = detectorBias(image, options, &pairs);
+  EXPECT_EQ(pairs, detectFeatures(image, options).size());
+  EXPECT_LT(bias.cwiseAbs().maxCoeff(), 0.03) << bias.transpose();
 }
 
 TEST(FeatureMatching, MutualCheckAndRatioTestRemoveMatches) {

@@ -52,9 +52,15 @@ TEST(PointInitialiser, RecoversThePlanarOrbitUpToSimilarity) {
   // The orbit spans about 0.2 m; its poses must come back within a millimetre.
   EXPECT_LT(errors.position_ate_sim3, 1e-3);  // 0.23 mm when written.
   EXPECT_GT(result.points.size(), 200u);
+  int observations = 0;
   for (const InitialisedPoint& p : result.points) {
     EXPECT_GE(p.observations.size(), 2u);
+    observations += static_cast<int>(p.observations.size());
   }
+  // Every observation is in front of its camera, and BA leaves the tracks' own noise.
+  EXPECT_EQ(result.reprojection.observations, observations);
+  EXPECT_LT(result.reprojection.rms_px, 1.0);
+  EXPECT_LT(result.reprojection.mean_px.norm(), 0.1);
 }
 
 // A camera looking down at a long textured floor flies 0.9 m along it and back, 3 cm to the
@@ -203,6 +209,10 @@ TEST(PointInitialiser, TriangulatesTheTracksAtGivenPosesWithoutMovingThem) {
   std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
   EXPECT_LT(heights[heights.size() / 2], 1e-2);
   EXPECT_EQ(result.scale_convention, "the given poses' unit");
+  // At the true poses the points fit their tracks; reprojectionSummary itself is tested in
+  // point_initialiser_test.cpp.
+  EXPECT_GT(result.reprojection.observations, 400);
+  EXPECT_LT(result.reprojection.rms_px, 1.0);
 }
 
 TEST(PointInitialiserOptions, ALoopMergeBoundOfZeroIsRefusedByName) {

@@ -967,10 +967,11 @@ RunInput RunCommand::loadInput() const {
       input.initialisation = triangulateAtPoses(input.sequence, input.frames, initialiser_);
       input.sightings = sightingsOfFrames(input.sequence, input.frames, *input.initialisation);
       const ReprojectionSummary& reprojection = input.initialisation->reprojection;
-      std::printf("run: %zu points from %d tracks at the given poses%s%s\n",
-                  input.initialisation->points.size(), input.initialisation->num_tracks,
-                  reprojection.observations > 0 ? "; " : "",
-                  reprojection.observations > 0 ? reprojectionLine(reprojection).c_str() : "");
+      std::string seen = std::to_string(input.initialisation->points.size()) + " points from " +
+                         std::to_string(input.initialisation->num_tracks) +
+                         " tracks at the given poses";
+      if (reprojection.observations > 0) seen += "; " + reprojectionLine(reprojection);
+      std::printf("run: %s\n", seen.c_str());
     }
     return input;
   }

@@ -82,8 +82,7 @@ int samplesToFind(int needed, int n, int sample_size, int cap) {
   return static_cast<int>(std::clamp(std::ceil(samples), 1.0, double(cap)));
 }
 
-}  // namespace
-
+// The matches a fundamental matrix or a homography explains (see the header's verifiedMatches).
 std::vector<FeatureMatch> verifiedMatches(const std::vector<FeatureMatch>& matches,
                                           double threshold_px, int min_matches) {
   if (static_cast<int>(matches.size()) < min_matches) return {};
@@ -119,6 +118,15 @@ std::vector<FeatureMatch> verifiedMatches(const std::vector<FeatureMatch>& match
     if (mask[i]) kept.push_back(matches[i]);
   }
   return kept;
+}
+
+}  // namespace
+
+std::vector<FeatureMatch> verifiedMatches(const FeatureSet& a, const FeatureSet& b,
+                                          const FeatureMatchingOptions& matching,
+                                          const FeatureTrackOptions& options) {
+  return verifiedMatches(matchFeatures(a, b, matching), options.verify_threshold_px,
+                         options.min_verified_matches);
 }
 
 namespace {
@@ -196,8 +204,7 @@ struct FeatureTrackBuilder::State {
   // Links the verified descriptor matches of `earlier` and `later` (a later matching frame).
   void matchPair(const MatchingFrame& earlier, const MatchingFrame& later) {
     const std::vector<FeatureMatch> matches =
-        verifiedMatches(matchFeatures(earlier.features, later.features, matching),
-                        options.verify_threshold_px, options.min_verified_matches);
+        verifiedMatches(earlier.features, later.features, matching, options);
     for (const FeatureMatch& match : matches) {
       links.emplace_back(keypointRef(earlier.first_keypoint + match.index_a),
                          keypointRef(later.first_keypoint + match.index_b));

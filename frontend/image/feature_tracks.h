@@ -126,12 +126,15 @@ struct FeatureTracks {
   std::vector<int> sharedTracks(int frame_a, int frame_b) const;
 };
 
-/// The matches a fundamental matrix or a homography explains within threshold_px (RANSAC,
-/// whichever keeps more), as COLMAP verifies every image pair before it builds tracks: one wrong
-/// match joins two scene points into one track. Fewer than `min_matches` survivors: none is
-/// kept. Deterministic (RANSAC draws from OpenCV's generator, seeded here).
-std::vector<FeatureMatch> verifiedMatches(const std::vector<FeatureMatch>& matches,
-                                          double threshold_px, int min_matches);
+/// The descriptor matches of two images that a fundamental matrix or a homography explains
+/// within options.verify_threshold_px (RANSAC, whichever keeps more), as COLMAP verifies every
+/// image pair before it builds tracks: one wrong match joins two scene points into one track.
+/// Fewer than options.min_verified_matches survivors: none is kept. The track builder's pairs and
+/// the point initialiser's loop matches both go through it. Deterministic (RANSAC draws from
+/// OpenCV's generator, seeded here).
+std::vector<FeatureMatch> verifiedMatches(const FeatureSet& a, const FeatureSet& b,
+                                          const FeatureMatchingOptions& matching,
+                                          const FeatureTrackOptions& options);
 
 /// Builds the tracks frame by frame. Feed every frame of a sequence in order (8-bit BGR or grey,
 /// undistorted, all of one size); not thread-safe.

@@ -839,9 +839,8 @@ struct PointInitialiser::State {
             !isLoopCandidate(model, a.frame, b.frame))
           continue;
         ++out.loops.candidate_pairs;
-        const std::vector<FeatureMatch> matches = verifiedMatches(
-            matchFeatures(a.features, b.features, options.features),
-            options.tracks.verify_threshold_px, options.tracks.min_verified_matches);
+        const std::vector<FeatureMatch> matches =
+            verifiedMatches(a.features, b.features, options.features, options.tracks);
         out.loops.verified_pairs += !matches.empty();
         for (const FeatureMatch& m : matches) {
           const LoopEnd end_a{a.frame, m.index_a, m.pixel_a, a.track_of_keypoint[m.index_a]};
@@ -1016,6 +1015,7 @@ struct PointInitialiser::State {
       for (int f : frames) point.observations.push_back({f, pixelOf(p.track, f)});
       out.points.push_back(std::move(point));
     }
+    out.reprojection = reprojectionSummary(*camera, out);
   }
 
   void addFrame(const cv::Mat& image) {
@@ -1062,7 +1062,6 @@ struct PointInitialiser::State {
     out.models = out.merged_models = model.registered() > 0 ? 1 : 0;
     out.scale_convention = "the given poses' unit";
     writeResult(model, {model}, std::vector<int>(numFrames(), 0));
-    out.reprojection = reprojectionSummary(*camera, out);
     out.seconds.total = add_frame_seconds + secondsSince(start);
     return std::move(out);
   }
@@ -1079,7 +1078,6 @@ struct PointInitialiser::State {
     } else {
       writeResult(Model(numFrames(), 0), models, std::vector<int>(numFrames(), -1));
     }
-    out.reprojection = reprojectionSummary(*camera, out);
     out.seconds.total = add_frame_seconds + secondsSince(start);
     return std::move(out);
   }

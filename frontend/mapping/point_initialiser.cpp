@@ -755,7 +755,11 @@ struct PointInitialiser::State {
       merged_any = true;
     }
     out.seconds.merge += secondsSince(start);
-    if (merged_any) globalRefinement(&merged, reference);
+    // A free focal length moves in every model's global BA: a reference built before the last
+    // model was refined under an older camera than the one written, so it is refined again.
+    const bool older_camera =
+        options.ba.refine_focal && reference != static_cast<int>(models.size()) - 1;
+    if (merged_any || older_camera) globalRefinement(&merged, reference);
     return merged;
   }
 

@@ -1,6 +1,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/errors.h"
 #include "core/trajectory_evaluation.h"
 #include "frontend/mapping/point_initialiser.h"
@@ -168,6 +171,40 @@ TEST(PointInitialiser, RefinesAFocalLengthGivenRoughly) {
   EXPECT_LT(
       evaluateTrajectory(scene.true_cam_from_world, registeredPoses(refined)).position_ate_sim3,
       1e-3);
+}
+
+// Two orbits over unrelated textures, one after the other: two models that share no point, so
+// nothing merges and the longer, first one is written. With a free focal length the second
+// model's global BA moves the camera after the first's; the written model must have been refined
+// last, under the camera that is written with it.
+TEST(PointInitialiser, TheWrittenModelIsRefinedUnderTheWrittenFocalLength) {
+  cv::Mat other(480, 640, CV_8UC1, cv::Scalar(128));
+  cv::RNG rng(23);
+  testing::drawRandomRectangles(&other, &rng, 500, 8, 40);
+  PlanarSceneOptions scene_options;
+  scene_options.intensity_noise = 0.01;
+  scene_options.num_frames = 10;
+  scene_options.arc_degrees = 27.0;
+  const PlanarScene first = makePlanarScene(testing::denseTexture(), scene_options);
+  scene_options.num_frames = 6;
+  scene_options.arc_degrees = 15.0;
+  const PlanarScene second = makePlanarScene(other, scene_options);
+  PointInitialiserOptions options;
+  options.ba.refine_focal = true;
+  PointInitialiser initialiser(first.camera->withFocalScale(1.05), options);
+  for (const PlanarScene* scene : {&first, &second}) {
+    for (const cv::Mat& image : scene->images) initialiser.addFrame(image);
+  }
+  const PointInitialisation result = initialiser.finish();
+  ASSERT_EQ(result.models, 2) << result.failure;
+  EXPECT_EQ(result.merged_models, 1);
+  EXPECT_EQ(result.registeredFrames(), 10);
+  const auto last_global =
+      std::find_if(result.bundle_adjustments.rbegin(), result.bundle_adjustments.rend(),
+                   [](const InitialiserBundleAdjustment& ba) { return ba.scope == "global"; });
+  ASSERT_NE(last_global, result.bundle_adjustments.rend());
+  EXPECT_EQ(last_global->model, 0);
+  EXPECT_EQ(last_global->frames, 10);
 }
 
 TEST(PointInitialiser, ScaleConventionIsMedianDepthOneInThePairsFirstFrame) {

@@ -1,9 +1,12 @@
 #include "factors/point_bundle_adjustment.h"
 
+#include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 
 #include "core/check.h"
 #include "core/errors.h"
+#include "core/so3.h"
 #include "factors/point_reprojection_factor.h"
 
 namespace curvesfm {
@@ -65,6 +68,113 @@ std::vector<Eigen::Vector3d> extractPoints(const Values& values, std::size_t num
 
 double extractFocalScale(const Values& values) {
   return values.exists(focalScaleKey()) ? values.at<double>(focalScaleKey()) : 1.0;
+}
+
+namespace {
+
+// One point's share of the information on the poses, the point eliminated (Schur complement),
+// added to `reduced` (6 per camera: the retraction's rotation then translation, Pose3). A point
+// that fewer than two views place, or that they place along a line only, adds nothing.
+void addPointInformation(const PointBundleAdjustmentInput& input,
+                         const std::vector<const PointObservation*>& seen,
+                         Eigen::MatrixXd* reduced) {
+  struct Block {
+    int camera;
+    Matrix6d pose_pose;
+    Eigen::Matrix<double, 6, 3> pose_point;
+  };
+  std::vector<Block> blocks;
+  Eigen::Matrix3d point_point = Eigen::Matrix3d::Zero();
+  for (const PointObservation* o : seen) {
+    const Pose3& pose = input.cam_from_world[o->camera_index];
+    const Eigen::Vector3d in_camera = pose * input.points[o->point_index];
+    Eigen::Vector2d pixel;
+    Matrix23d d_pixel;
+    if (!input.camera->project(in_camera, &pixel, &d_pixel)) continue;
+    Eigen::Matrix<double, 2, 6> d_pose;
+    d_pose << -d_pixel * so3::hat(in_camera), d_pixel;
+    const Matrix23d d_point = d_pixel * pose.rotationMatrix();
+    point_point += d_point.transpose() * d_point;
+    blocks.push_back({o->camera_index, d_pose.transpose() * d_pose, d_pose.transpose() * d_point});
+  }
+  if (blocks.size() < 2) return;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> point_eigen(point_point);
+  if (point_eigen.eigenvalues()(0) <= 1e-12 * point_eigen.eigenvalues()(2)) return;
+  const Eigen::Matrix3d point_inverse = point_point.inverse();
+  for (const Block& a : blocks) {
+    reduced->block<6, 6>(6 * a.camera, 6 * a.camera) += a.pose_pose;
+    for (const Block& b : blocks) {
+      reduced->block<6, 6>(6 * a.camera, 6 * b.camera) -=
+          a.pose_point * point_inverse * b.pose_point.transpose();
+    }
+  }
+}
+
+// An orthonormal basis of the centre moves a similarity makes (translation, rotation and scale
+// about the centres' mean), 3 rows per camera.
+Eigen::MatrixXd similarityDirections(const std::vector<Eigen::Vector3d>& centres) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& c : centres) mean += c / static_cast<double>(centres.size());
+  Eigen::MatrixXd moves(3 * centres.size(), 7);
+  for (std::size_t i = 0; i < centres.size(); ++i) {
+    const Eigen::Vector3d r = centres[i] - mean;
+    moves.block<3, 3>(3 * i, 0).setIdentity();
+    moves.block<3, 3>(3 * i, 3) = -so3::hat(r);
+    moves.block<3, 1>(3 * i, 6) = r;
+  }
+  return Eigen::HouseholderQR<Eigen::MatrixXd>(moves).householderQ() *
+         Eigen::MatrixXd::Identity(moves.rows(), 7);
+}
+
+}  // namespace
+
+double predictedCentreAte(const PointBundleAdjustmentInput& input, double pixel_sigma) {
+  CURVESFM_CHECK(input.camera != nullptr) << "the centres' precision needs a camera";
+  CURVESFM_CHECK(pixel_sigma > 0.0) << "pixel std dev " << pixel_sigma << " must be > 0";
+  const int cameras = static_cast<int>(input.cam_from_world.size());
+  if (cameras < 3) return std::numeric_limits<double>::infinity();
+  std::vector<std::vector<const PointObservation*>> by_point(input.points.size());
+  for (const PointObservation& o : input.observations) {
+    CURVESFM_CHECK(o.camera_index >= 0 && o.camera_index < cameras && o.point_index >= 0 &&
+                   o.point_index < static_cast<int>(input.points.size()))
+        << "observation of point " << o.point_index << " in camera " << o.camera_index
+        << " is out of range";
+    by_point[o.point_index].push_back(&o);
+  }
+  Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(6 * cameras, 6 * cameras);
+  for (const auto& seen : by_point) {
+    if (seen.size() >= 2) addPointInformation(input, seen, &reduced);
+  }
+  reduced /= pixel_sigma * pixel_sigma;
+  // Rotations and translations in one matrix: its unit-free form (unit diagonal) keeps the
+  // eigenvalues comparable in any length unit.
+  if ((reduced.diagonal().array() <= 0.0).any()) return std::numeric_limits<double>::infinity();
+  const Eigen::VectorXd scale = reduced.diagonal().cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd unit_free = scale.asDiagonal() * reduced * scale.asDiagonal();
+  // The seven smallest eigenvalues belong to the similarity (the gauge); any further one near
+  // zero leaves a direction that the observations do not fix.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(unit_free);
+  const Eigen::VectorXd& values = eigen.eigenvalues();
+  if (values(7) <= 1e-9 * values(values.size() - 1)) return std::numeric_limits<double>::infinity();
+  const Eigen::MatrixXd vectors =
+      scale.asDiagonal() * eigen.eigenvectors().rightCols(values.size() - 7);
+  const Eigen::VectorXd inverse = values.tail(values.size() - 7).cwiseInverse();
+  // A pose's centre -R^T t moves by -R^T u for a retraction (w, u); w leaves it.
+  Eigen::MatrixXd centre_from_pose = Eigen::MatrixXd::Zero(3 * cameras, vectors.cols());
+  std::vector<Eigen::Vector3d> centres;
+  for (int i = 0; i < cameras; ++i) {
+    const Pose3& pose = input.cam_from_world[i];
+    centres.push_back(pose.inverseTranslation());
+    centre_from_pose.middleRows<3>(3 * i) =
+        -pose.rotationMatrix().transpose() * vectors.middleRows<3>(6 * i + 3);
+  }
+  const Eigen::MatrixXd basis = similarityDirections(centres);
+  // Centre errors with the similarity's moves taken out, per unit of each eigen-direction's
+  // standard deviation.
+  const Eigen::MatrixXd aligned =
+      (centre_from_pose - basis * (basis.transpose() * centre_from_pose)) *
+      inverse.cwiseSqrt().asDiagonal();
+  return std::sqrt(aligned.squaredNorm() / cameras);
 }
 
 }  // namespace curvesfm

@@ -63,4 +63,15 @@ std::vector<Eigen::Vector3d> extractPoints(const Values& values, std::size_t num
 /// The factor on the camera's focal lengths in `values` (1 when the problem did not refine it).
 double extractFocalScale(const Values& values);
 
+/// How precisely `input`'s observations fix its camera centres: the rms centre error after a
+/// Sim(3) alignment (the ATE's metric) that pixel noise of std dev `pixel_sigma` per coordinate
+/// leaves at the optimum of a BA without robust kernel, to first order (the Cramér-Rao bound of
+/// the centres): the information of every observation at `input`'s poses and points, the points
+/// eliminated, the seven similarity directions that the alignment takes out projected away.
+/// A lower bound on the ATE that such a BA reaches against the truth: it knows no bias, outlier
+/// or camera error. Observations behind their camera do not count; points seen fewer than twice
+/// carry nothing. Infinite when the observations leave more than the similarity free (cameras
+/// that share no point, a camera seeing fewer than three points). In input's length unit.
+double predictedCentreAte(const PointBundleAdjustmentInput& input, double pixel_sigma);
+
 }  // namespace curvesfm

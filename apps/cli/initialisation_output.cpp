@@ -224,8 +224,24 @@ std::string reprojectionLine(const ReprojectionSummary& r) {
   std::snprintf(text, sizeof(text),
                 "%d observations reproject with rms %.3f px, mean residual (%.3f, %.3f) px",
                 r.observations, r.rms_px, r.mean_px.x(), r.mean_px.y());
-  return text;
+  std::string line = text;
+  if (r.predicted_centre_ate) {
+    std::snprintf(text, sizeof(text), "; that noise alone would leave the centres an ATE of %.3g",
+                  *r.predicted_centre_ate);
+    line += text;
+  }
+  return line;
 }
+
+namespace {
+
+// In the unit `scale` takes the map's to; null when not computed or not finite.
+nlohmann::json predictedCentreAteJson(const ReprojectionSummary& r, double scale) {
+  if (!r.predicted_centre_ate || !std::isfinite(*r.predicted_centre_ate)) return nullptr;
+  return scale * *r.predicted_centre_ate;
+}
+
+}  // namespace
 
 nlohmann::json initialisationToJson(const ImageSequence& sequence,
                                     const PointInitialisation& result) {
@@ -268,7 +284,8 @@ nlohmann::json initialisationToJson(const ImageSequence& sequence,
           {"reprojection",
            {{"observations", result.reprojection.observations},
             {"mean_px", {result.reprojection.mean_px.x(), result.reprojection.mean_px.y()}},
-            {"rms_px", result.reprojection.rms_px}}},
+            {"rms_px", result.reprojection.rms_px},
+            {"predicted_centre_ate", predictedCentreAteJson(result.reprojection, 1.0)}}},
           {"scale_convention", result.scale_convention},
           {"focal_scale", result.focal_scale},
           {"initial_pair",
@@ -350,13 +367,20 @@ nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
         "init ATE (sim3) vs %s over %d frames: rmse %.6f, mean %.6f, median %.6f (ground "
         "truth unit)\n",
         sequence.ground_truth_source.c_str(), e.ate.count, e.ate.rmse, e.ate.mean, e.ate.median);
+    const nlohmann::json predicted =
+        predictedCentreAteJson(result.reprojection, e.ground_truth_from_estimate.scale);
+    if (!predicted.is_null()) {
+      std::printf("init ATE from the points' pixel noise alone: %.6f (ground truth unit)\n",
+                  predicted.get<double>());
+    }
     return {{"alignment", "sim3"},
             {"matched", e.ate.count},
             {"rmse", e.ate.rmse},
             {"mean", e.ate.mean},
             {"median", e.ate.median},
             {"max", e.ate.max},
-            {"rpe_translation_rmse", e.rpe_translation_stats.rmse}};
+            {"rpe_translation_rmse", e.rpe_translation_stats.rmse},
+            {"predicted_from_pixel_noise", predicted}};
   } catch (const TrajectoryEvaluationError& e) {
     std::printf("init ATE: not computed: %s\n", e.what());
     return {{"problem", e.what()}};

@@ -909,7 +909,9 @@ void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* o,
       .number("min_merge_points", "min-merge-points", &o->min_merge_points,
               "Fewest shared points to merge two sub-models by Sim(3)")
       .threads("tracking_threads", "tracking-threads", &o->tracking_threads,
-               "OpenCV threads while building the tracks (0: every core)");
+               "OpenCV threads while building the tracks (0: every core)")
+      .number("precision_max_frames", "precision-max-frames", &o->precision_max_frames,
+              "The centres' predicted precision for at most this many posed frames (0: never)");
   table
       ->group(&o->undistort, "ImageUndistorterOptions", path + "/undistort", "points-undistort-",
               heading)

@@ -17,6 +17,7 @@
 #include "core/median.h"
 #include "core/point_triangulation.h"
 #include "core/similarity_alignment.h"
+#include "factors/point_bundle_adjustment.h"
 #include "factors/pose_variables.h"
 #include "graph/key.h"
 
@@ -84,6 +85,7 @@ void PointInitialiserOptions::validate() const {
   require(fallback_min_inliers >= 4, "fallback_min_inliers", fallback_min_inliers, ">= 4");
   require(max_models >= 1, "max_models", max_models, ">= 1");
   require(min_merge_points >= 3, "min_merge_points", min_merge_points, ">= 3");
+  require(precision_max_frames >= 0, "precision_max_frames", precision_max_frames, ">= 0");
 }
 
 int PointInitialisation::registeredFrames() const {
@@ -1020,6 +1022,12 @@ struct PointInitialiser::State {
       out.points.push_back(std::move(point));
     }
     out.reprojection = reprojectionSummary(*camera, out);
+    const int posed = out.registeredFrames();
+    if (out.reprojection.observations > 0 && posed <= options.precision_max_frames) {
+      // The rms is of the residual's length: two coordinates.
+      out.reprojection.predicted_centre_ate =
+          predictedCentreAte(*camera, out, out.reprojection.rms_px / std::sqrt(2.0));
+    }
   }
 
   void addFrame(const cv::Mat& image) {
@@ -1114,6 +1122,30 @@ double InitialiserTimes::tracksMsPerVgaFrame(int frames, int width, int height) 
   if (frames <= 0 || width <= 0 || height <= 0) return 0.0;
   return 1e3 * (undistort + klt + matching) / frames * (640.0 * 480.0) /
          (static_cast<double>(width) * height);
+}
+
+double predictedCentreAte(const Camera& camera, const PointInitialisation& result,
+                          double pixel_sigma) {
+  PointBundleAdjustmentInput input;
+  input.camera = std::make_shared<Camera>(camera);
+  std::vector<int> camera_of_frame(result.frames.size(), -1);
+  for (std::size_t f = 0; f < result.frames.size(); ++f) {
+    if (!result.frames[f].cam_from_world) continue;
+    camera_of_frame[f] = static_cast<int>(input.cam_from_world.size());
+    input.cam_from_world.push_back(*result.frames[f].cam_from_world);
+  }
+  for (const InitialisedPoint& point : result.points) {
+    const int index = static_cast<int>(input.points.size());
+    input.points.push_back(point.position);
+    for (const TrackObservation& o : point.observations) {
+      CURVESFM_CHECK(o.frame >= 0 && o.frame < static_cast<int>(result.frames.size()))
+          << "an observation in frame " << o.frame << " of " << result.frames.size();
+      if (camera_of_frame[o.frame] >= 0) {
+        input.observations.push_back({camera_of_frame[o.frame], index, o.pixel});
+      }
+    }
+  }
+  return predictedCentreAte(input, pixel_sigma);
 }
 
 PointInitialiser::PointInitialiser(const Camera& camera, const PointInitialiserOptions& options)

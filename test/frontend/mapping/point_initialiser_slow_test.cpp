@@ -64,6 +64,14 @@ TEST(PointInitialiser, RecoversThePlanarOrbitUpToSimilarity) {
   EXPECT_EQ(result.reprojection.observations, observations);
   EXPECT_LT(result.reprojection.rms_px, 1.0);
   EXPECT_LT(result.reprojection.mean_px.norm(), 0.1);
+  // At that noise the points fix the 16 centres (a finite figure); with a bound below the
+  // posed frames none is computed.
+  ASSERT_TRUE(result.reprojection.predicted_centre_ate.has_value());
+  EXPECT_GT(*result.reprojection.predicted_centre_ate, 0.0);
+  EXPECT_TRUE(std::isfinite(*result.reprojection.predicted_centre_ate));
+  PointInitialiserOptions unpredicted;
+  unpredicted.precision_max_frames = 15;
+  EXPECT_FALSE(initialise(scene, unpredicted).reprojection.predicted_centre_ate.has_value());
 }
 
 // A camera looking down at a long textured floor flies 0.9 m along it and back, 3 cm to the
@@ -260,6 +268,17 @@ TEST(PointInitialiserOptions, ALoopMergeBoundOfZeroIsRefusedByName) {
     ADD_FAILURE() << "loops.max_merge_error_px 0 accepted";
   } catch (const InvalidOptions& e) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("max_merge_error_px"));
+  }
+}
+
+TEST(PointInitialiserOptions, ANegativePrecisionFrameBoundIsRefusedByName) {
+  PointInitialiserOptions options;
+  options.precision_max_frames = -1;
+  try {
+    options.validate();
+    ADD_FAILURE() << "precision_max_frames -1 accepted";
+  } catch (const InvalidOptions& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("precision_max_frames"));
   }
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "factors/point_bundle_adjustment.h"
 #include "sim/point_scene.h"
 
 namespace curvesfm {
@@ -90,6 +91,25 @@ TEST(ReprojectionSummary, NothingObservedGivesZeros) {
   EXPECT_EQ(r.observations, 0);
   EXPECT_EQ(r.mean_px, Eigen::Vector2d::Zero());
   EXPECT_EQ(r.rms_px, 0.0);
+}
+
+// The result's frames as the factor layer's cameras: the posed ones in frame order, the
+// observations in unposed frames left out. Here frame 0 unposed: cameras 1-7 of the scene.
+TEST(ReprojectionSummary, PredictsTheCentresOfThePosedFramesOnly) {
+  ShiftedScene s = atTruth(Eigen::Vector2d::Zero());
+  s.result.frames[0].cam_from_world.reset();
+  PointBundleAdjustmentInput posed{
+      s.scene.camera,
+      {s.scene.true_cam_from_world.begin() + 1, s.scene.true_cam_from_world.end()},
+      s.scene.true_points,
+      {}};
+  for (const PointObservation& o : s.scene.observations) {
+    if (o.camera_index > 0)
+      posed.observations.push_back({o.camera_index - 1, o.point_index, o.pixel});
+  }
+  const double expected = predictedCentreAte(posed, 0.7);
+  EXPECT_GT(expected, 0.0);
+  EXPECT_NEAR(predictedCentreAte(*s.scene.camera, s.result, 0.7), expected, 1e-12 * expected);
 }
 
 }  // namespace

@@ -216,6 +216,10 @@ struct Row {
   double map_recall = std::nan("");
   /// Curve cost per observation after the run's last BA (report.json final_fit); NaN without.
   double curve_cost_per_observation = std::nan("");
+  /// The ATE that the initialiser's points' pixel noise alone would leave (report.json
+  /// reprojection.precision.predicted_centre_ate, in the row's own unit until evaluate() scales
+  /// it to the ground truth's): how far the points fix the trajectory at all. NaN without.
+  double points_ate_floor = std::nan("");
   // Wall times (s); NaN where the variant has no such stage.
   double tracks_s = std::nan("");
   /// Tracks per frame scaled to 640x480 (ms, wall time on Options::tracking_threads).
@@ -300,6 +304,7 @@ void evaluate(const std::vector<StampedPose>& estimate, const ImageSequence& seq
                             row->variant, sequence.ground_truth_source);
     row->evaluated = e.ate.count;
     row->ate = e.ate;
+    row->points_ate_floor *= e.ground_truth_from_estimate.scale;
     row->rpe = e.rpe_translation_stats;
     std::vector<StampedPose> aligned;
     for (const MatchedPose& m : e.matches) {
@@ -316,9 +321,18 @@ double number(const nlohmann::json& json, const std::string& key) {
   return json.contains(key) && json[key].is_number() ? json[key].get<double>() : std::nan("");
 }
 
-// The initialiser's part of a report.json (init: the top level; run: "initialiser").
-void readInitialiserTimes(const nlohmann::json& part, Row* row) {
+// The initialiser's part of a report.json (init: the top level; run: "initialiser"): its times,
+// counts and the points' floor.
+void readInitialiser(const nlohmann::json& part, Row* row) {
   if (!part.is_object() || !part.contains("seconds")) return;
+  const nlohmann::json precision =
+      part.value("reprojection", nlohmann::json::object()).value("precision", nlohmann::json());
+  if (precision.is_object()) {
+    const nlohmann::json& ate = precision["predicted_centre_ate"];
+    row->points_ate_floor = ate.is_number()   ? ate.get<double>()
+                            : ate.is_string() ? std::numeric_limits<double>::infinity()
+                                              : std::nan("");
+  }
   const nlohmann::json& s = part["seconds"];
   row->tracks_s = number(s, "undistort") + number(s, "klt") + number(s, "matching");
   row->tracks_ms = number(s, "tracks_ms_per_640x480_frame");
@@ -436,9 +450,9 @@ void runCurvesfm(const BenchOptions& options, const Variant& variant, const Real
   }
   const nlohmann::json report = readReport(dir / "report.json");
   if (variant.command == "init") {
-    readInitialiserTimes(report, row);
+    readInitialiser(report, row);
   } else {
-    readInitialiserTimes(report.value("initialiser", nlohmann::json()), row);
+    readInitialiser(report.value("initialiser", nlohmann::json()), row);
     readPipelineTimes(report, row);
     const nlohmann::json ate = report.value("ate", nlohmann::json::object());
     if (ate.is_object() && ate.contains("initial_m"))
@@ -717,7 +731,8 @@ void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
   out << "set,variant,start,repetition,status,frames,registered,evaluated,start_ate_rmse,ate_rmse,"
          "ate_mean,"
          "ate_median,map_precision_2cm,map_recall_2cm,curve_cost_per_observation,"
-         "rpe_translation_rmse,tracks_s,tracks_ms_per_640x480_frame,init_s,curves_s,local_ba_s,"
+         "points_ate_floor,rpe_translation_rmse,tracks_s,tracks_ms_per_640x480_frame,init_s,curves_"
+         "s,local_ba_s,"
          "global_ba_s,extraction_s,"
          "matching_s,mapping_s,total_s,note\n";
   for (const Row& r : rows) {
@@ -730,6 +745,7 @@ void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
         << formatNumber(ok ? r.ate.median : nan, "%.9g") << ","
         << formatNumber(r.map_precision, "%.4g") << "," << formatNumber(r.map_recall, "%.4g") << ","
         << formatNumber(r.curve_cost_per_observation, "%.6g") << ","
+        << formatNumber(ok ? r.points_ate_floor : nan, "%.6g") << ","
         << formatNumber(ok && r.rpe.count > 0 ? r.rpe.rmse : nan, "%.9g") << ","
         << formatNumber(r.tracks_s, "%.6g") << "," << formatNumber(r.tracks_ms, "%.6g") << ","
         << formatNumber(r.init_s, "%.6g") << "," << formatNumber(r.curves_s, "%.6g") << ","
@@ -761,6 +777,7 @@ std::string markdownRow(const Row& r) {
        << " | " << (ok ? std::to_string(r.evaluated) : "") << " | " << formatNumber(r.start_ate)
        << " | " << formatNumber(ok ? r.ate.rmse : nan) << " | "
        << formatNumber(ok && r.start != "truth" ? r.ate.rmse / r.start_ate : nan, "%.3f") << " | "
+       << formatNumber(ok ? r.points_ate_floor : nan) << " | "
        << formatNumber(ok ? r.ate.mean : nan) << " | " << formatNumber(ok ? r.ate.median : nan)
        << " | "
        << (std::isnan(r.map_precision)
@@ -778,14 +795,15 @@ std::string markdownRow(const Row& r) {
 std::string markdownTable(const std::vector<Row>& rows, int tracking_threads) {
   std::ostringstream out;
   out << "| set | variant | start | registered | evaluated | start ATE | ATE rmse | ATE / start "
-         "| ATE mean | ATE median | map P / R at 2 cm | RPE t rmse "
+         "| points' ATE floor | ATE mean | ATE median | map P / R at 2 cm | RPE t rmse "
          "| tracks s | tracks ms per 640x480 frame, "
       << (tracking_threads == 1 ? std::string("one core")
                                 : std::to_string(tracking_threads) + " threads")
       << " | init s | curves s | local BA s | "
          "global BA s | COLMAP extract / match / "
          "map s | total s | note |\n"
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+         "\n";
   for (const Row& r : rows) out << markdownRow(r) << "\n";
   return out.str();
 }

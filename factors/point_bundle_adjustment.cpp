@@ -99,8 +99,10 @@ void addPointInformation(const PointBundleAdjustmentInput& input,
   }
   if (blocks.size() < 2) return;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> point_eigen(point_point);
-  if (point_eigen.eigenvalues()(0) <= 1e-12 * point_eigen.eigenvalues()(2)) return;
-  const Eigen::Matrix3d point_inverse = point_point.inverse();
+  const Eigen::Vector3d& lambda = point_eigen.eigenvalues();
+  if (lambda(0) <= 1e-8 * lambda(2)) return;
+  const Eigen::Matrix3d& v = point_eigen.eigenvectors();
+  const Eigen::Matrix3d point_inverse = v * lambda.cwiseInverse().asDiagonal() * v.transpose();
   for (const Block& a : blocks) {
     reduced->block<6, 6>(6 * a.camera, 6 * a.camera) += a.pose_pose;
     for (const Block& b : blocks) {
@@ -111,7 +113,8 @@ void addPointInformation(const PointBundleAdjustmentInput& input,
 }
 
 // An orthonormal basis of the centre moves a similarity makes (translation, rotation and scale
-// about the centres' mean), 3 rows per camera.
+// about the centres' mean), 3 rows per camera: fewer than 7 columns where the centres lie on a
+// line (a turn about it moves none of them).
 Eigen::MatrixXd similarityDirections(const std::vector<Eigen::Vector3d>& centres) {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& c : centres) mean += c / static_cast<double>(centres.size());
@@ -122,17 +125,16 @@ Eigen::MatrixXd similarityDirections(const std::vector<Eigen::Vector3d>& centres
     moves.block<3, 3>(3 * i, 3) = -so3::hat(r);
     moves.block<3, 1>(3 * i, 6) = r;
   }
-  return Eigen::HouseholderQR<Eigen::MatrixXd>(moves).householderQ() *
-         Eigen::MatrixXd::Identity(moves.rows(), 7);
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(moves, Eigen::ComputeThinU);
+  const Eigen::VectorXd& singular = svd.singularValues();
+  const int rank = static_cast<int>((singular.array() > 1e-9 * singular(0)).count());
+  return svd.matrixU().leftCols(rank);
 }
 
-}  // namespace
-
-double predictedCentreAte(const PointBundleAdjustmentInput& input, double pixel_sigma) {
-  CURVESFM_CHECK(input.camera != nullptr) << "the centres' precision needs a camera";
-  CURVESFM_CHECK(pixel_sigma > 0.0) << "pixel std dev " << pixel_sigma << " must be > 0";
+// Each point's observations; CheckError for an index out of range.
+std::vector<std::vector<const PointObservation*>> observationsByPoint(
+    const PointBundleAdjustmentInput& input) {
   const int cameras = static_cast<int>(input.cam_from_world.size());
-  if (cameras < 3) return std::numeric_limits<double>::infinity();
   std::vector<std::vector<const PointObservation*>> by_point(input.points.size());
   for (const PointObservation& o : input.observations) {
     CURVESFM_CHECK(o.camera_index >= 0 && o.camera_index < cameras && o.point_index >= 0 &&
@@ -141,6 +143,43 @@ double predictedCentreAte(const PointBundleAdjustmentInput& input, double pixel_
         << " is out of range";
     by_point[o.point_index].push_back(&o);
   }
+  return by_point;
+}
+
+}  // namespace
+
+double estimatedPixelSigma(const PointBundleAdjustmentInput& input, bool poses_fitted) {
+  CURVESFM_CHECK(input.camera != nullptr) << "the pixel noise needs a camera";
+  double squares = 0.0;
+  int observations = 0;
+  int points = 0;
+  for (const auto& seen : observationsByPoint(input)) {
+    int in_front = 0;
+    double point_squares = 0.0;
+    for (const PointObservation* o : seen) {
+      Eigen::Vector2d projected;
+      const Pose3& pose = input.cam_from_world[o->camera_index];
+      if (!input.camera->project(pose * input.points[o->point_index], &projected)) continue;
+      point_squares += (o->pixel - projected).squaredNorm();
+      ++in_front;
+    }
+    if (in_front < 2) continue;  // A point seen once fits its observation exactly.
+    squares += point_squares;
+    observations += in_front;
+    ++points;
+  }
+  const int cameras = static_cast<int>(input.cam_from_world.size());
+  const int fitted = 3 * points + (poses_fitted ? std::max(0, 6 * cameras - 7) : 0);
+  const int redundancy = 2 * observations - fitted;
+  return redundancy > 0 ? std::sqrt(squares / redundancy) : std::nan("");
+}
+
+double predictedCentreAte(const PointBundleAdjustmentInput& input, double pixel_sigma) {
+  CURVESFM_CHECK(input.camera != nullptr) << "the centres' precision needs a camera";
+  CURVESFM_CHECK(pixel_sigma > 0.0) << "pixel std dev " << pixel_sigma << " must be > 0";
+  const int cameras = static_cast<int>(input.cam_from_world.size());
+  if (cameras < 3) return 0.0;  // A similarity fits two centres exactly.
+  const std::vector<std::vector<const PointObservation*>> by_point = observationsByPoint(input);
   Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(6 * cameras, 6 * cameras);
   for (const auto& seen : by_point) {
     if (seen.size() >= 2) addPointInformation(input, seen, &reduced);

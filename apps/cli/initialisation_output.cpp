@@ -225,20 +225,29 @@ std::string reprojectionLine(const ReprojectionSummary& r) {
                 "%d observations reproject with rms %.3f px, mean residual (%.3f, %.3f) px",
                 r.observations, r.rms_px, r.mean_px.x(), r.mean_px.y());
   std::string line = text;
-  if (r.predicted_centre_ate) {
-    std::snprintf(text, sizeof(text), "; that noise alone would leave the centres an ATE of %.3g",
-                  *r.predicted_centre_ate);
-    line += text;
-  }
-  return line;
+  if (!r.precision) return line;
+  if (std::isinf(r.precision->predicted_ate)) return line + "; they do not fix every centre";
+  std::snprintf(text, sizeof(text),
+                "; their noise, %.3f px per coordinate, alone would leave the centres an ATE of "
+                "%.3g (the poses' unit)",
+                r.precision->pixel_sigma, r.precision->predicted_ate);
+  return line + text;
 }
 
 namespace {
 
-// In the unit `scale` takes the map's to; null when not computed or not finite.
+// The predicted ATE in the unit `scale` takes the poses' to: a number, "infinite" where the
+// points do not fix every centre, null when not computed.
 nlohmann::json predictedCentreAteJson(const ReprojectionSummary& r, double scale) {
-  if (!r.predicted_centre_ate || !std::isfinite(*r.predicted_centre_ate)) return nullptr;
-  return scale * *r.predicted_centre_ate;
+  if (!r.precision) return nullptr;
+  if (std::isinf(r.precision->predicted_ate)) return "infinite";
+  return scale * r.precision->predicted_ate;
+}
+
+nlohmann::json precisionJson(const ReprojectionSummary& r) {
+  if (!r.precision) return nullptr;
+  return {{"pixel_sigma", r.precision->pixel_sigma},
+          {"predicted_centre_ate", predictedCentreAteJson(r, 1.0)}};
 }
 
 }  // namespace
@@ -285,7 +294,7 @@ nlohmann::json initialisationToJson(const ImageSequence& sequence,
            {{"observations", result.reprojection.observations},
             {"mean_px", {result.reprojection.mean_px.x(), result.reprojection.mean_px.y()}},
             {"rms_px", result.reprojection.rms_px},
-            {"predicted_centre_ate", predictedCentreAteJson(result.reprojection, 1.0)}}},
+            {"precision", precisionJson(result.reprojection)}}},
           {"scale_convention", result.scale_convention},
           {"focal_scale", result.focal_scale},
           {"initial_pair",
@@ -308,6 +317,7 @@ nlohmann::json initialisationToJson(const ImageSequence& sequence,
             {"global_ba", t.global_ba},
             {"merge", t.merge},
             {"loops", t.loops},
+            {"precision", t.precision},
             {"total", t.total},
             {"tracks_ms_per_640x480_frame",
              t.tracksMsPerVgaFrame(static_cast<int>(result.frames.size()), sequence.camera.width(),
@@ -341,11 +351,12 @@ nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
       "init time: tracks %.2f s (KLT %.2f, descriptors %.2f; %.1f ms per frame, %.1f ms per "
       "640x480 "
       "frame), pair search %.2f s, registration %.2f s, triangulation %.2f s, "
-      "local BA %.2f s, global BA %.2f s, total %.2f s\n",
+      "local BA %.2f s, global BA %.2f s, precision %.2f s, total %.2f s\n",
       t.klt + t.matching + t.undistort, t.klt, t.matching,
       frames > 0 ? 1e3 * (t.klt + t.matching + t.undistort) / frames : 0.0,
       t.tracksMsPerVgaFrame(frames, sequence.camera.width(), sequence.camera.height()),
-      t.pair_search, t.registration, t.triangulation, t.local_ba, t.global_ba, t.total);
+      t.pair_search, t.registration, t.triangulation, t.local_ba, t.global_ba, t.precision,
+      t.total);
   const LoopMatchStats& loops = result.loops;
   if (loops.candidate_pairs > 0) {
     std::printf(
@@ -369,7 +380,7 @@ nlohmann::json printInitialisationSummary(const ImageSequence& sequence,
         sequence.ground_truth_source.c_str(), e.ate.count, e.ate.rmse, e.ate.mean, e.ate.median);
     const nlohmann::json predicted =
         predictedCentreAteJson(result.reprojection, e.ground_truth_from_estimate.scale);
-    if (!predicted.is_null()) {
+    if (predicted.is_number()) {
       std::printf("init ATE from the points' pixel noise alone: %.6f (ground truth unit)\n",
                   predicted.get<double>());
     }

@@ -991,7 +991,8 @@ struct PointInitialiser::State {
   // -------------------------------------------------------------------------------------------
   // Output.
 
-  void writeResult(const Model& merged, const std::vector<Model>& models,
+  // `poses_fitted`: the poses were refined with the points, not given.
+  void writeResult(bool poses_fitted, const Model& merged, const std::vector<Model>& models,
                    const std::vector<int>& model_of_frame) {
     for (int f = 0; f < numFrames(); ++f) {
       InitialisedFrame& frame = out.frames[f];
@@ -1023,10 +1024,10 @@ struct PointInitialiser::State {
     }
     out.reprojection = reprojectionSummary(*camera, out);
     const int posed = out.registeredFrames();
-    if (out.reprojection.observations > 0 && posed <= options.precision_max_frames) {
-      // The rms is of the residual's length: two coordinates.
-      out.reprojection.predicted_centre_ate =
-          predictedCentreAte(*camera, out, out.reprojection.rms_px / std::sqrt(2.0));
+    if (out.reprojection.observations > 0 && posed >= 3 && posed <= options.precision_max_frames) {
+      const Clock::time_point start = Clock::now();
+      out.reprojection.precision = centrePrecision(*camera, out, poses_fitted);
+      out.seconds.precision = secondsSince(start);
     }
   }
 
@@ -1073,7 +1074,7 @@ struct PointInitialiser::State {
     out.seconds.triangulation += secondsSince(triangulation);
     out.models = out.merged_models = model.registered() > 0 ? 1 : 0;
     out.scale_convention = "the given poses' unit";
-    writeResult(model, {model}, std::vector<int>(numFrames(), 0));
+    writeResult(false, model, {model}, std::vector<int>(numFrames(), 0));
     out.seconds.total = add_frame_seconds + secondsSince(start);
     return std::move(out);
   }
@@ -1086,9 +1087,9 @@ struct PointInitialiser::State {
       std::vector<int> model_of_frame(numFrames(), -1);
       Model merged = mergeModels(models, &model_of_frame);
       closeLoops(&merged, model_of_frame[merged.pair.first]);
-      writeResult(merged, models, model_of_frame);
+      writeResult(true, merged, models, model_of_frame);
     } else {
-      writeResult(Model(numFrames(), 0), models, std::vector<int>(numFrames(), -1));
+      writeResult(true, Model(numFrames(), 0), models, std::vector<int>(numFrames(), -1));
     }
     out.seconds.total = add_frame_seconds + secondsSince(start);
     return std::move(out);
@@ -1124,8 +1125,9 @@ double InitialiserTimes::tracksMsPerVgaFrame(int frames, int width, int height) 
          (static_cast<double>(width) * height);
 }
 
-double predictedCentreAte(const Camera& camera, const PointInitialisation& result,
-                          double pixel_sigma) {
+std::optional<CentrePrecision> centrePrecision(const Camera& camera,
+                                               const PointInitialisation& result,
+                                               bool poses_fitted) {
   PointBundleAdjustmentInput input;
   input.camera = std::make_shared<Camera>(camera);
   std::vector<int> camera_of_frame(result.frames.size(), -1);
@@ -1145,7 +1147,9 @@ double predictedCentreAte(const Camera& camera, const PointInitialisation& resul
       }
     }
   }
-  return predictedCentreAte(input, pixel_sigma);
+  const double sigma = estimatedPixelSigma(input, poses_fitted);
+  if (!(sigma > 0.0)) return std::nullopt;  // NaN: nothing left free.
+  return CentrePrecision{sigma, predictedCentreAte(input, sigma)};
 }
 
 PointInitialiser::PointInitialiser(const Camera& camera, const PointInitialiserOptions& options)

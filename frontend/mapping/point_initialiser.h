@@ -164,8 +164,8 @@ struct PointInitialiserOptions {
   /// it too unless --points-tracking-threads is given. cv::setNumThreads is process-wide: other
   /// OpenCV work in the process while the tracks are built runs with this count. >= 0.
   int tracking_threads = 1;
-  /// The result's predicted centre precision (ReprojectionSummary::predicted_centre_ate) is
-  /// computed up to this many posed frames (count; 0: never). Its eigen-decomposition grows
+  /// The result's centre precision (ReprojectionSummary::precision) is computed up to this
+  /// many posed frames (count; 0: never). Its eigen-decomposition grows
   /// with the cube of the frames: about 0.2 s at 100 frames, 6 s at 300. >= 0.
   int precision_max_frames = 200;
   /// Throws InvalidOptions naming the first field outside its range (also of the nested ones).
@@ -215,6 +215,21 @@ struct InitialisedPoint {
   std::vector<TrackObservation> observations;
 };
 
+/// How precisely a map's points fix its posed frames' centres, from their own residuals.
+struct CentrePrecision {
+  /// The pixel noise the residuals say, per coordinate, net of what was fitted to them
+  /// (estimatedPixelSigma; px); > 0.
+  double pixel_sigma = 0.0;
+  /// The ATE (after Sim(3) alignment, in the poses' unit) that this noise alone would leave the
+  /// centres at a point BA's optimum, to first order (predictedCentreAte): the floor of what
+  /// the points can tell. Far below the ATE against a ground truth, it says that the ground
+  /// truth, the camera or a bias of the points, not the noise, makes the difference. Meaningful
+  /// at poses the images agree with (the initialiser's own, or an exact truth): at poses off by
+  /// pixels the residuals, and so the floor, carry their error too. Infinite when the
+  /// observations do not fix every centre.
+  double predicted_ate = 0.0;
+};
+
 /// How a map's points reproject into the frames that observe them: residual = observed pixel -
 /// projected pixel (undistorted pixels). At the initialiser's own poses it is what BA left; at
 /// given poses it says how well those poses and the camera agree with the images (a start off by
@@ -225,13 +240,10 @@ struct ReprojectionSummary {
   int observations = 0;                               ///< In front of their cameras.
   Eigen::Vector2d mean_px = Eigen::Vector2d::Zero();  ///< Mean residual (px).
   double rms_px = 0.0;                                ///< Root mean square of its length (px).
-  /// How precisely these observations fix the posed frames' centres: the ATE (after Sim(3)
-  /// alignment, in the map's unit) that pixel noise at this rms leaves, to first order
-  /// (predictedCentreAte). Far below the ATE against a ground truth, it says that the ground
-  /// truth or a bias of the points, not the noise, makes the difference. Unset when not computed
-  /// (more posed frames than PointInitialiserOptions::precision_max_frames); infinite when the
-  /// observations do not fix every centre.
-  std::optional<double> predicted_centre_ate;
+  /// How precisely these observations fix the posed frames' centres (centrePrecision). Unset
+  /// when not computed (fewer than three or more than PointInitialiserOptions::
+  /// precision_max_frames posed frames) or when the residuals tell no noise.
+  std::optional<CentrePrecision> precision;
 };
 
 /// One bundle adjustment the initialiser ran.
@@ -249,6 +261,8 @@ struct InitialiserTimes {
   /// Loop matches: finding and matching the candidate pairs and merging tracks (the global BA and
   /// re-triangulation after each round count in global_ba and triangulation).
   double loops = 0.0;
+  /// The centres' precision (ReprojectionSummary::precision), an eigen-decomposition.
+  double precision = 0.0;
   /// Undistortion and tracks per frame, scaled to a 640x480 frame by the pixel count (ms): the
   /// tracking budget of issue 13 (50 ms on one core, tracking_threads 1) in any image size.
   double tracksMsPerVgaFrame(int frames, int width, int height) const;
@@ -295,10 +309,12 @@ struct PointInitialisation {
 /// camera the pixels refer to).
 ReprojectionSummary reprojectionSummary(const Camera& camera, const PointInitialisation& result);
 
-/// predictedCentreAte (factors/point_bundle_adjustment.h) of `result`'s points in its posed
-/// frames, at std dev `pixel_sigma` per coordinate: in the map's unit.
-double predictedCentreAte(const Camera& camera, const PointInitialisation& result,
-                          double pixel_sigma);
+/// The CentrePrecision of `result`'s points in its posed frames, projected by `camera`; with
+/// `poses_fitted` the poses were refined with the points (the initialiser's own), else given.
+/// None when the residuals tell no noise: none left free by the fit, or all zero.
+std::optional<CentrePrecision> centrePrecision(const Camera& camera,
+                                               const PointInitialisation& result,
+                                               bool poses_fitted);
 
 /// Runs the initialiser over a sequence: feed every frame in order, then finish(). Not
 /// thread-safe.

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <vector>
 
 #include "factors/point_bundle_adjustment.h"
@@ -94,9 +95,10 @@ TEST(ReprojectionSummary, NothingObservedGivesZeros) {
 }
 
 // The result's frames as the factor layer's cameras: the posed ones in frame order, the
-// observations in unposed frames left out. Here frame 0 unposed: cameras 1-7 of the scene.
-TEST(ReprojectionSummary, PredictsTheCentresOfThePosedFramesOnly) {
-  ShiftedScene s = atTruth(Eigen::Vector2d::Zero());
+// observations in unposed frames left out. Here frame 0 unposed: cameras 1-7 of the scene, whose
+// observations are all 0.3, -0.2 px off (a noise the residuals tell).
+TEST(CentrePrecision, CoversThePosedFramesOnly) {
+  ShiftedScene s = atTruth(Eigen::Vector2d(0.3, -0.2));
   s.result.frames[0].cam_from_world.reset();
   PointBundleAdjustmentInput posed{
       s.scene.camera,
@@ -104,12 +106,24 @@ TEST(ReprojectionSummary, PredictsTheCentresOfThePosedFramesOnly) {
       s.scene.true_points,
       {}};
   for (const PointObservation& o : s.scene.observations) {
-    if (o.camera_index > 0)
-      posed.observations.push_back({o.camera_index - 1, o.point_index, o.pixel});
+    if (o.camera_index > 0) {
+      posed.observations.push_back(
+          {o.camera_index - 1, o.point_index, o.pixel + Eigen::Vector2d(0.3, -0.2)});
+    }
   }
-  const double expected = predictedCentreAte(posed, 0.7);
+  const double sigma = estimatedPixelSigma(posed, false);
+  const double expected = predictedCentreAte(posed, sigma);
   EXPECT_GT(expected, 0.0);
-  EXPECT_NEAR(predictedCentreAte(*s.scene.camera, s.result, 0.7), expected, 1e-12 * expected);
+  const std::optional<CentrePrecision> precision =
+      centrePrecision(*s.scene.camera, s.result, false);
+  ASSERT_TRUE(precision.has_value());
+  EXPECT_NEAR(precision->pixel_sigma, sigma, 1e-12 * sigma);
+  EXPECT_NEAR(precision->predicted_ate, expected, 1e-12 * expected);
+}
+
+TEST(CentrePrecision, NoneWhereTheResidualsTellNoNoise) {
+  const ShiftedScene s = atTruth(Eigen::Vector2d::Zero());
+  EXPECT_FALSE(centrePrecision(*s.scene.camera, s.result, true).has_value());
 }
 
 }  // namespace

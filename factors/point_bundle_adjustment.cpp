@@ -146,6 +146,17 @@ std::vector<std::vector<const PointObservation*>> observationsByPoint(
   return by_point;
 }
 
+// The information on the poses (6 per camera) that the observations give at std dev
+// `pixel_sigma`, the points eliminated.
+Eigen::MatrixXd poseInformation(const PointBundleAdjustmentInput& input, double pixel_sigma) {
+  const int cameras = static_cast<int>(input.cam_from_world.size());
+  Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(6 * cameras, 6 * cameras);
+  for (const auto& seen : observationsByPoint(input)) {
+    if (seen.size() >= 2) addPointInformation(input, seen, &reduced);
+  }
+  return reduced / (pixel_sigma * pixel_sigma);
+}
+
 }  // namespace
 
 double estimatedPixelSigma(const PointBundleAdjustmentInput& input, bool poses_fitted) {
@@ -179,12 +190,7 @@ double predictedCentreAte(const PointBundleAdjustmentInput& input, double pixel_
   CURVESFM_CHECK(pixel_sigma > 0.0) << "pixel std dev " << pixel_sigma << " must be > 0";
   const int cameras = static_cast<int>(input.cam_from_world.size());
   if (cameras < 3) return 0.0;  // A similarity fits two centres exactly.
-  const std::vector<std::vector<const PointObservation*>> by_point = observationsByPoint(input);
-  Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(6 * cameras, 6 * cameras);
-  for (const auto& seen : by_point) {
-    if (seen.size() >= 2) addPointInformation(input, seen, &reduced);
-  }
-  reduced /= pixel_sigma * pixel_sigma;
+  const Eigen::MatrixXd reduced = poseInformation(input, pixel_sigma);
   // Rotations and translations in one matrix: its unit-free form (unit diagonal) keeps the
   // eigenvalues comparable in any length unit.
   if ((reduced.diagonal().array() <= 0.0).any()) return std::numeric_limits<double>::infinity();

@@ -165,8 +165,8 @@ struct PointInitialiserOptions {
   /// OpenCV work in the process while the tracks are built runs with this count. >= 0.
   int tracking_threads = 1;
   /// The result's centre precision (ReprojectionSummary::precision) is computed up to this
-  /// many posed frames (count; 0: never). Its eigen-decomposition grows
-  /// with the cube of the frames: about 0.2 s at 100 frames, 6 s at 300. >= 0.
+  /// many posed frames (count; 0: never). Its eigen-decomposition grows with the cube of the
+  /// frames: 0.3 s at 100 frames (Pavilion, the kitchen), several seconds at 300. >= 0.
   int precision_max_frames = 200;
   /// Throws InvalidOptions naming the first field outside its range (also of the nested ones).
   void validate() const;

@@ -55,7 +55,8 @@ void writeInitialisedPoints(const std::string& path, const PointInitialisation& 
 nlohmann::json cameraToJson(const Camera& camera);
 
 /// "N observations reproject with rms R px, mean residual (x, y) px": the summary line of a
-/// ReprojectionSummary.
+/// ReprojectionSummary, followed by its centre precision when it has one (the noise per
+/// coordinate and the ATE it alone would leave, or that the points do not fix every centre).
 std::string reprojectionLine(const ReprojectionSummary& reprojection);
 
 /// The report.json part of the initialiser: counts, the points' reprojection, the scale

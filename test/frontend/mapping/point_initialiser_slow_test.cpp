@@ -268,34 +268,22 @@ TEST(PointInitialiser, TriangulatesTheTracksAtGivenPosesWithoutMovingThem) {
 TEST(PointInitialiserOptions, ALoopMergeBoundOfZeroIsRefusedByName) {
   PointInitialiserOptions options;
   options.loops.max_merge_error_px = 0.0;
-  try {
-    options.validate();
-    ADD_FAILURE() << "loops.max_merge_error_px 0 accepted";
-  } catch (const InvalidOptions& e) {
-    EXPECT_THAT(e.what(), ::testing::HasSubstr("max_merge_error_px"));
-  }
+  EXPECT_THAT([&] { options.validate(); },
+              ::testing::ThrowsMessage<InvalidOptions>(::testing::HasSubstr("max_merge_error_px")));
 }
 
 TEST(PointInitialiserOptions, ANegativePrecisionFrameBoundIsRefusedByName) {
   PointInitialiserOptions options;
   options.precision_max_frames = -1;
-  try {
-    options.validate();
-    ADD_FAILURE() << "precision_max_frames -1 accepted";
-  } catch (const InvalidOptions& e) {
-    EXPECT_THAT(e.what(), ::testing::HasSubstr("precision_max_frames"));
-  }
+  EXPECT_THAT([&] { options.validate(); }, ::testing::ThrowsMessage<InvalidOptions>(
+                                               ::testing::HasSubstr("precision_max_frames")));
 }
 
 TEST(PointInitialiserOptions, ANegativeTrackingThreadCountIsRefusedByName) {
   PointInitialiserOptions options;
   options.tracking_threads = -1;
-  try {
-    options.validate();
-    ADD_FAILURE() << "tracking_threads -1 accepted";
-  } catch (const InvalidOptions& e) {
-    EXPECT_THAT(e.what(), ::testing::HasSubstr("tracking_threads"));
-  }
+  EXPECT_THAT([&] { options.validate(); },
+              ::testing::ThrowsMessage<InvalidOptions>(::testing::HasSubstr("tracking_threads")));
 }
 
 TEST(PointInitialiser, ATexturelessSequenceFailsWithAReason) {

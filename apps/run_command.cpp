@@ -944,6 +944,22 @@ std::vector<Pose3> RunCommand::frontendPoses(const RunInput& input) const {
   return frontend;
 }
 
+namespace {
+
+// " (gate G px[, S x their median error M px])": how the points at given poses were gated.
+std::string gateText(const PointInitialisation& points, double gate_scale) {
+  char text[160];
+  if (points.given_poses_median_error_px > 0.0) {
+    std::snprintf(text, sizeof(text), " (gate %.3g px, %.3g x their median error %.3g px)",
+                  points.given_poses_gate_px, gate_scale, points.given_poses_median_error_px);
+  } else {
+    std::snprintf(text, sizeof(text), " (gate %.3g px)", points.given_poses_gate_px);
+  }
+  return text;
+}
+
+}  // namespace
+
 RunInput RunCommand::loadInput() const {
   RunInput input;
   std::optional<FallbackCamera> model_camera;
@@ -969,7 +985,8 @@ RunInput RunCommand::loadInput() const {
       const ReprojectionSummary& reprojection = input.initialisation->reprojection;
       std::string seen = std::to_string(input.initialisation->points.size()) + " points from " +
                          std::to_string(input.initialisation->num_tracks) +
-                         " tracks at the given poses";
+                         " tracks at the given poses" +
+                         gateText(*input.initialisation, initialiser_.given_poses_gate_scale);
       if (reprojection.observations > 0) seen += "; " + reprojectionLine(reprojection);
       std::printf("run: %s\n", seen.c_str());
     }

@@ -1,5 +1,6 @@
 #include "core/point_triangulation.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
@@ -27,6 +28,45 @@ bool triangulateDlt(const std::vector<Pose3>& cam_from_world,
   const Eigen::Vector3d result = X.head<3>() / X(3);
   if (!result.allFinite()) return false;
   *point = result;
+  return true;
+}
+
+bool refinePointAtPoses(const std::vector<Pose3>& cam_from_world,
+                        const std::vector<Eigen::Vector2d>& normalized, Eigen::Vector3d* point) {
+  const std::size_t n = cam_from_world.size();
+  if (n < 2 || normalized.size() != n) return false;
+  // A handful of steps: the start is within a pixel or two of the optimum, where Gauss-Newton
+  // converges quadratically; the bound only stops a point that runs off along a degenerate ray.
+  constexpr int kMaxIterations = 10;
+  constexpr double kRelativeStep = 1e-10;
+  Eigen::Vector3d x = *point;
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Matrix3d R = cam_from_world[i].rotationMatrix();
+      const Eigen::Vector3d c = R * x + cam_from_world[i].translation();
+      if (!(c.z() > 0.0)) return false;
+      const double inv_z = 1.0 / c.z();
+      const Eigen::Vector2d residual(c.x() * inv_z - normalized[i].x(),
+                                     c.y() * inv_z - normalized[i].y());
+      Eigen::Matrix<double, 2, 3> d_projection;
+      d_projection << inv_z, 0.0, -c.x() * inv_z * inv_z, 0.0, inv_z, -c.y() * inv_z * inv_z;
+      const Eigen::Matrix<double, 2, 3> J = d_projection * R;
+      normal += J.transpose() * J;
+      gradient += J.transpose() * residual;
+    }
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
+    if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-14)) return false;
+    const Eigen::Vector3d step = -ldlt.solve(gradient);
+    if (!step.allFinite()) return false;
+    x += step;
+    if (step.norm() <= kRelativeStep * x.norm()) break;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!((cam_from_world[i] * x).z() > 0.0)) return false;
+  }
+  *point = x;
   return true;
 }
 

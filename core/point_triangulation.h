@@ -21,6 +21,16 @@ namespace curvesfm {
 bool triangulateDlt(const std::vector<Pose3>& cam_from_world,
                     const std::vector<Eigen::Vector2d>& normalized, Eigen::Vector3d* point);
 
+/// Gauss-Newton on `point` alone, the poses held: minimises the sum of squared normalized
+/// reprojection errors (x / z - u, y / z - v) over every view, from `point` as the start (a DLT
+/// point, say). A point the given poses place from two of its views only carries those two
+/// views' errors; the least squares over all of them averages every view's (the structure-only
+/// step of COLMAP's and ORB-SLAM's triangulation at known poses). Returns false (and leaves
+/// `point` alone) with fewer than two views, when the sizes differ, when a view would see the
+/// point behind it or the normal equations are singular (parallel rays).
+bool refinePointAtPoses(const std::vector<Pose3>& cam_from_world,
+                        const std::vector<Eigen::Vector2d>& normalized, Eigen::Vector3d* point);
+
 /// The largest angle at `point` between the rays from any two of the camera centres (deg): the
 /// best baseline the observations offer. 0 with fewer than two centres.
 double maxTriangulationAngleDeg(const std::vector<Eigen::Vector3d>& centres,

@@ -894,6 +894,13 @@ void addPointInitialiserOptions(OptionsTable* table, PointInitialiserOptions* o,
               "The pair score counts the median angle up to this (deg)")
       .number("max_reprojection_error_px", "max-reprojection-error", &o->max_reprojection_error_px,
               "Largest reprojection error of an observation kept in the map (px)")
+      .boolean("refine_at_given_poses", "refine-at-given-poses", &o->refine_at_given_poses,
+               "At given poses, refine each point over its views within the gate (poses held)")
+      .number("given_poses_gate_scale", "given-poses-gate-scale", &o->given_poses_gate_scale,
+              "At given poses, with refine-at-given-poses, gate at this times the points' median "
+              "reprojection error (0: fixed)")
+      .number("given_poses_max_gate_px", "given-poses-max-gate", &o->given_poses_max_gate_px,
+              "At given poses, the widest gate (px)")
       .number("min_triangulation_angle_deg", "min-triangulation-angle",
               &o->min_triangulation_angle_deg, "Smallest ray angle of a triangulated point (deg)")
       .number("local_ba_frames", "local-ba-frames", &o->local_ba_frames,

@@ -86,6 +86,14 @@ void PointInitialiserOptions::validate() const {
   require(max_models >= 1, "max_models", max_models, ">= 1");
   require(min_merge_points >= 3, "min_merge_points", min_merge_points, ">= 3");
   require(precision_max_frames >= 0, "precision_max_frames", precision_max_frames, ">= 0");
+  require(given_poses_gate_scale >= 0.0 && given_poses_gate_scale < 1e6, "given_poses_gate_scale",
+          given_poses_gate_scale, "finite and >= 0");
+  require(given_poses_gate_scale == 0.0 || refine_at_given_poses, "given_poses_gate_scale",
+          given_poses_gate_scale,
+          "0 unless refine_at_given_poses (the gate is the refined points')");
+  require(given_poses_max_gate_px >= max_reprojection_error_px && given_poses_max_gate_px < 1e6,
+          "given_poses_max_gate_px", given_poses_max_gate_px,
+          "finite and >= max_reprojection_error_px");
 }
 
 int PointInitialisation::registeredFrames() const {
@@ -225,30 +233,38 @@ struct PointInitialiser::State {
     return frames;
   }
 
+  // The frame of `frames` whose centre lies farthest from frame a's (-1 if none but a).
+  int farthestFrame(const Model& model, const std::vector<int>& frames, int a) const {
+    int b = -1;
+    double widest = -1.0;
+    const Eigen::Vector3d centre_a = centreOf(*model.poses[a]);
+    for (int f : frames) {
+      const double d = (centreOf(*model.poses[f]) - centre_a).norm();
+      if (f != a && d > widest) {
+        widest = d;
+        b = f;
+      }
+    }
+    return b;
+  }
+
+  bool triangulatePair(const Model& model, int track, int a, int b, Eigen::Vector3d* point) const {
+    return triangulateDlt({*model.poses[a], *model.poses[b]},
+                          {camera->pixelToNormalized(pixelOf(track, a)),
+                           camera->pixelToNormalized(pixelOf(track, b))},
+                          point);
+  }
+
   // Triangulates `track` from its registered observations (see the header, step 4); `anchor` is
   // the frame to pair with the farthest other one (the new frame), or -1 for the track's ends.
   bool triangulateTrack(Model* model, int track, int anchor) const {
     const std::vector<int> frames = registeredFramesOf(*model, track);
     if (frames.size() < 2) return false;
     const int a = anchor >= 0 ? anchor : frames.front();
-    int b = -1;
-    double widest = -1.0;
-    const Eigen::Vector3d centre_a = centreOf(*model->poses[a]);
-    for (int f : frames) {
-      const double d = (centreOf(*model->poses[f]) - centre_a).norm();
-      if (f != a && d > widest) {
-        widest = d;
-        b = f;
-      }
-    }
-    if (b < 0) return false;
+    const int b = farthestFrame(*model, frames, a);
     Eigen::Vector3d point;
-    if (!triangulateDlt({*model->poses[a], *model->poses[b]},
-                        {camera->pixelToNormalized(pixelOf(track, a)),
-                         camera->pixelToNormalized(pixelOf(track, b))},
-                        &point)) {
-      return false;
-    }
+    if (b < 0 || !triangulatePair(*model, track, a, b, &point)) return false;
+    const Eigen::Vector3d centre_a = centreOf(*model->poses[a]);
     if (!reprojects(*model, a, track, point) || !reprojects(*model, b, track, point) ||
         triangulationAngleDeg(centre_a, centreOf(*model->poses[b]), point) <
             options.min_triangulation_angle_deg) {
@@ -1058,6 +1074,80 @@ struct PointInitialiser::State {
     out.frames.assign(numFrames(), InitialisedFrame{});
   }
 
+  // The point of `track` at poses held: the two-view point of its first view and the one
+  // farthest from it, refined by least squares over every registered view within `gate_px` of
+  // it, twice (a view the seed puts beyond the gate may come within it of the refined point).
+  // Adds it with the views within the gate; false when fewer than two remain or their rays are
+  // too close to parallel.
+  bool triangulateTrackAtPoses(Model* model, int track, double gate_px) const {
+    const std::vector<int> frames = registeredFramesOf(*model, track);
+    if (frames.size() < 2) return false;
+    const int b = farthestFrame(*model, frames, frames.front());
+    Eigen::Vector3d point;
+    if (b < 0 || !triangulatePair(*model, track, frames.front(), b, &point)) return false;
+    const auto framesWithinGate = [&] {
+      std::vector<int> within;
+      for (int f : frames) {
+        if (reprojectsWithin(*model, f, pixelOf(track, f), point, gate_px)) within.push_back(f);
+      }
+      return within;
+    };
+    for (int round = 0; round < 2; ++round) {
+      const std::vector<int> within = framesWithinGate();
+      if (within.size() < 2) return false;
+      std::vector<Pose3> poses;
+      std::vector<Eigen::Vector2d> normalized;
+      for (int f : within) {
+        poses.push_back(*model->poses[f]);
+        normalized.push_back(camera->pixelToNormalized(pixelOf(track, f)));
+      }
+      if (!refinePointAtPoses(poses, normalized, &point)) return false;
+    }
+    std::vector<int> kept = framesWithinGate();
+    if (kept.size() < 2 || angleDeg(*model, kept, point) < options.min_triangulation_angle_deg) {
+      return false;
+    }
+    model->addPoint(point, track, std::move(kept));
+    return true;
+  }
+
+  // The median reprojection error of the tracks triangulated within given_poses_max_gate_px at
+  // the model's poses (px; 0 when none is).
+  double medianErrorAtPoses(Model model) const {
+    std::vector<double> errors;
+    for (int track = 0; track < static_cast<int>(tracks.tracks.size()); ++track) {
+      if (!triangulateTrackAtPoses(&model, track, options.given_poses_max_gate_px)) continue;
+      const MapPoint& point = model.points[model.point_of_track[track]];
+      for (int f : point.frames) {
+        Eigen::Vector2d projected;
+        if (camera->project(*model.poses[f] * point.position, &projected)) {
+          errors.push_back((projected - pixelOf(track, f)).norm());
+        }
+      }
+    }
+    return errors.empty() ? 0.0 : upperMedian(errors);
+  }
+
+  // Triangulates every track at the model's (given) poses: refined over its views within a gate
+  // that follows the residuals, or as finish() would without refine_at_given_poses.
+  void triangulateAtPoses(Model* model) {
+    out.given_poses_gate_px = options.max_reprojection_error_px;
+    if (!options.refine_at_given_poses) {
+      retriangulateAll(model);
+      filterPoints(model, allPoints(*model));
+      return;
+    }
+    if (options.given_poses_gate_scale > 0.0) {
+      out.given_poses_median_error_px = medianErrorAtPoses(*model);
+      out.given_poses_gate_px =
+          std::clamp(options.given_poses_gate_scale * out.given_poses_median_error_px,
+                     options.max_reprojection_error_px, options.given_poses_max_gate_px);
+    }
+    for (int track = 0; track < static_cast<int>(tracks.tracks.size()); ++track) {
+      triangulateTrackAtPoses(model, track, out.given_poses_gate_px);
+    }
+  }
+
   PointInitialisation finishAtPoses(const std::vector<std::optional<Pose3>>& cam_from_world) {
     CURVESFM_CHECK(static_cast<int>(cam_from_world.size()) == frames_added)
         << "finishAtPoses: " << cam_from_world.size() << " poses for " << frames_added << " frames";
@@ -1069,8 +1159,7 @@ struct PointInitialiser::State {
       if (cam_from_world[f]) model.registerFrame(f, *cam_from_world[f]);
     }
     const Clock::time_point triangulation = Clock::now();
-    retriangulateAll(&model);
-    filterPoints(&model, allPoints(model));
+    triangulateAtPoses(&model);
     out.seconds.triangulation += secondsSince(triangulation);
     out.models = out.merged_models = model.registered() > 0 ? 1 : 0;
     out.scale_convention = "the given poses' unit";

@@ -137,6 +137,30 @@ struct PointInitialiserOptions {
   double pair_parallax_cap_deg = 20.0;
   /// Largest reprojection error of an observation kept in the map (px; COLMAP 4). Finite, > 0.
   double max_reprojection_error_px = 4.0;
+  /// At given poses (finishAtPoses), each point is refined by least squares over its views
+  /// within the gate, the poses held (refinePointAtPoses; COLMAP's point_triangulator runs a BA
+  /// with the poses held), instead of kept where the two views farthest apart put it: a
+  /// two-view point carries those two views' errors into every other view's residual. Off by
+  /// default, measured (docs/benchmarks.md, "Points at given poses refined", session 52): the
+  /// six real sets' truth starts drift less on five (KITTI 06 15.8 -> 13.0 mm) and their noise
+  /// starts end level (geometric mean 0.785 against 0.780 x), but the planar noise starts end
+  /// further on 15 of 17: the start model (StartModelOptions) reads the start's noise against
+  /// these points, its prior scales were set against the two-view ones, and the better fit
+  /// makes it tie the start tighter.
+  bool refine_at_given_poses = false;
+  /// At given poses, with refine_at_given_poses, the gate follows the residuals: this times the
+  /// median reprojection error of the tracks triangulated within given_poses_max_gate_px, bounded
+  /// by max_reprojection_error_px below and given_poses_max_gate_px above (unitless; 0: the
+  /// fixed max_reprojection_error_px). A start the images agree with has a median near the
+  /// tracks' noise (0.2-0.4 px on five real sets, 1.4 px on 7-Scenes' ground truth) and keeps the
+  /// fixed gate; a start off by pixels per pose (2-4 px) would otherwise keep only the tracks
+  /// that agree with its errors (docs/benchmarks.md, "Points at a start"). The median of a 2D
+  /// Gaussian residual's norm is 1.18 sigma, so 3 gates at 3.5 sigma. Off by default: it serves
+  /// the hybrid graph (--ba-points), which is off. >= 0.
+  double given_poses_gate_scale = 0.0;
+  /// The widest gate at given poses, and the one the median is measured within (px).
+  /// >= max_reprojection_error_px.
+  double given_poses_max_gate_px = 12.0;
   /// Smallest angle between the rays of a triangulated point (deg; COLMAP 1.5). In [0, 90).
   double min_triangulation_angle_deg = 1.5;
   /// Frames refined by local BA: the new frame and those registered just before it (count).
@@ -297,6 +321,10 @@ struct PointInitialisation {
   double focal_scale = 1.0;
   std::vector<InitialiserBundleAdjustment> bundle_adjustments;
   std::vector<FeatureTrackFrameStats> track_stats;  ///< Per frame.
+  /// finishAtPoses: the reprojection gate applied (px) and, where it follows the residuals
+  /// (given_poses_gate_scale), their median within given_poses_max_gate_px (px); 0 otherwise.
+  double given_poses_gate_px = 0.0;
+  double given_poses_median_error_px = 0.0;
   /// The points' residuals in the registered frames, at the poses returned.
   ReprojectionSummary reprojection;
   InitialiserTimes seconds;
@@ -329,8 +357,10 @@ class PointInitialiser {
   /// what could not be done.
   PointInitialisation finish();
   /// Triangulates the tracks at known poses instead (cam_from_world per frame given, in the
-  /// poses' unit; a frame without one is left out), with the gates of finish() and no BA: the
-  /// points of a run that brings its own poses, for the keyframes' depth ranges and the hybrid
+  /// poses' unit; a frame without one is left out), with the angle gate of finish(), each point
+  /// refined over its views with the poses held (refine_at_given_poses) and gated by
+  /// max_reprojection_error_px or by the residuals (given_poses_gate_scale): the points of a run
+  /// that brings its own poses, for the keyframes' depth ranges, the start model and the hybrid
   /// graph (COLMAP's point_triangulator does the same for a known model). Every posed frame is
   /// "registered" with its pose unchanged. Call instead of finish(), once.
   PointInitialisation finishAtPoses(const std::vector<std::optional<Pose3>>& cam_from_world);

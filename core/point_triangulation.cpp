@@ -35,8 +35,8 @@ bool refinePointAtPoses(const std::vector<Pose3>& cam_from_world,
                         const std::vector<Eigen::Vector2d>& normalized, Eigen::Vector3d* point) {
   const std::size_t n = cam_from_world.size();
   if (n < 2 || normalized.size() != n) return false;
-  // A handful of steps: the start is within a pixel or two of the optimum, where Gauss-Newton
-  // converges quadratically; the bound only stops a point that runs off along a degenerate ray.
+  // From a DLT point Gauss-Newton converges in a few steps (the residuals are small against the
+  // depth); the bound only stops a point that runs off along a nearly degenerate ray.
   constexpr int kMaxIterations = 10;
   constexpr double kRelativeStep = 1e-10;
   Eigen::Vector3d x = *point;

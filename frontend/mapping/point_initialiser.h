@@ -144,7 +144,7 @@ struct PointInitialiserOptions {
   /// default, measured (docs/benchmarks.md, "Points at given poses refined", session 52): the
   /// six real sets' truth starts drift less on five (KITTI 06 15.8 -> 13.0 mm) and their noise
   /// starts end level (geometric mean 0.785 against 0.780 x), but the planar noise starts end
-  /// further on 15 of 17: the start model (StartModelOptions) reads the start's noise against
+  /// further on 39 of 45: the start model (StartModelOptions) reads the start's noise against
   /// these points, its prior scales were set against the two-view ones, and the better fit
   /// makes it tie the start tighter.
   bool refine_at_given_poses = false;
@@ -152,10 +152,10 @@ struct PointInitialiserOptions {
   /// median reprojection error of the tracks triangulated within given_poses_max_gate_px, bounded
   /// by max_reprojection_error_px below and given_poses_max_gate_px above (unitless; 0: the
   /// fixed max_reprojection_error_px). A start the images agree with has a median near the
-  /// tracks' noise (0.2-0.4 px on five real sets, 1.4 px on 7-Scenes' ground truth) and keeps the
-  /// fixed gate; a start off by pixels per pose (2-4 px) would otherwise keep only the tracks
-  /// that agree with its errors (docs/benchmarks.md, "Points at a start"). The median of a 2D
-  /// Gaussian residual's norm is 1.18 sigma, so 3 gates at 3.5 sigma. Off by default: it serves
+  /// tracks' noise (0.2-0.5 px on five real sets, 1.7 px on 7-Scenes' ground truth) and keeps the
+  /// fixed gate; a start off by pixels per pose (medians 1.4-5 px) would otherwise keep only the
+  /// tracks that agree with its errors (docs/benchmarks.md, "Points at a start"). The median of a
+  /// 2D Gaussian residual's norm is 1.18 sigma, so 3 gates at 3.5 sigma. Off by default: it serves
   /// the hybrid graph (--ba-points), which is off. >= 0.
   double given_poses_gate_scale = 0.0;
   /// The widest gate at given poses, and the one the median is measured within (px).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <initializer_list>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <opencv2/core/utility.hpp>
@@ -204,9 +205,18 @@ struct PointInitialiser::State {
   // Whether `point` lies in front of the frame and reprojects within `bound_px` of `pixel`.
   bool reprojectsWithin(const Model& model, int frame, const Eigen::Vector2d& pixel,
                         const Eigen::Vector3d& point, double bound_px) const {
+    return reprojectionErrorPx(model, frame, pixel, point) <= bound_px;
+  }
+
+  // The distance from `pixel` to `point` projected into the frame (px), infinite when the point
+  // does not project (behind the camera).
+  double reprojectionErrorPx(const Model& model, int frame, const Eigen::Vector2d& pixel,
+                             const Eigen::Vector3d& point) const {
     Eigen::Vector2d projected;
-    if (!camera->project(*model.poses[frame] * point, &projected)) return false;
-    return (projected - pixel).norm() <= bound_px;
+    if (!camera->project(*model.poses[frame] * point, &projected)) {
+      return std::numeric_limits<double>::infinity();
+    }
+    return (projected - pixel).norm();
   }
 
   // The widest ray angle among (at most 8 evenly spread) frames: the gate needs the baseline the
@@ -1118,11 +1128,9 @@ struct PointInitialiser::State {
     for (int track = 0; track < static_cast<int>(tracks.tracks.size()); ++track) {
       if (!triangulateTrackAtPoses(&model, track, options.given_poses_max_gate_px)) continue;
       const MapPoint& point = model.points[model.point_of_track[track]];
+      // Every view kept lies within the gate, so every error is finite.
       for (int f : point.frames) {
-        Eigen::Vector2d projected;
-        if (camera->project(*model.poses[f] * point.position, &projected)) {
-          errors.push_back((projected - pixelOf(track, f)).norm());
-        }
+        errors.push_back(reprojectionErrorPx(model, f, pixelOf(track, f), point.position));
       }
     }
     return errors.empty() ? 0.0 : upperMedian(errors);

@@ -234,14 +234,34 @@ TEST(PointInitialiser, ScaleConventionIsMedianDepthOneInThePairsFirstFrame) {
   EXPECT_NEAR(depths[depths.size() / 2], 1.0, 0.1);
 }
 
+// The true poses of `scene`, each turned about its own centre by a rotation of `sigma_deg` per
+// axis, independent per pose (a start off per pose by a few pixels).
+std::vector<std::optional<Pose3>> turnedPoses(const PlanarScene& scene, double sigma_deg) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, sigma_deg * M_PI / 180.0);
+  std::vector<std::optional<Pose3>> poses;
+  for (const Pose3& truth : scene.true_cam_from_world) {
+    const Eigen::Quaterniond rotation =
+        so3::exp(Eigen::Vector3d(noise(rng), noise(rng), noise(rng))) * truth.rotation();
+    poses.emplace_back(Pose3(rotation, -(rotation * truth.inverseTranslation())));
+  }
+  return poses;
+}
+
+PointInitialisation atPoses(const PlanarScene& scene,
+                            const std::vector<std::optional<Pose3>>& poses,
+                            const PointInitialiserOptions& options) {
+  PointInitialiser initialiser(*scene.camera, options);
+  for (const cv::Mat& image : scene.images) initialiser.addFrame(image);
+  return initialiser.finishAtPoses(poses);
+}
+
 TEST(PointInitialiser, TriangulatesTheTracksAtGivenPosesWithoutMovingThem) {
   const PlanarScene scene = orbitScene(8);
-  PointInitialiser initialiser(*scene.camera, {});
-  for (const cv::Mat& image : scene.images) initialiser.addFrame(image);
   std::vector<std::optional<Pose3>> poses(scene.true_cam_from_world.begin(),
                                           scene.true_cam_from_world.end());
   poses[3].reset();  // A frame without a given pose stays out.
-  const PointInitialisation result = initialiser.finishAtPoses(poses);
+  const PointInitialisation result = atPoses(scene, poses, {});
   EXPECT_EQ(result.registeredFrames(), 7);
   EXPECT_FALSE(result.frames[3].cam_from_world.has_value());
   EXPECT_EQ(result.frames[4].cam_from_world->translation(),
@@ -265,28 +285,6 @@ TEST(PointInitialiser, TriangulatesTheTracksAtGivenPosesWithoutMovingThem) {
   // point_initialiser_test.cpp.
   EXPECT_GT(result.reprojection.observations, 400);
   EXPECT_LT(result.reprojection.rms_px, 1.0);
-}
-
-// The true poses of `scene`, each turned about its own centre by a rotation of `sigma_deg` per
-// axis, independent per pose (a start off per pose by a few pixels).
-std::vector<std::optional<Pose3>> turnedPoses(const PlanarScene& scene, double sigma_deg) {
-  std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0.0, sigma_deg * M_PI / 180.0);
-  std::vector<std::optional<Pose3>> poses;
-  for (const Pose3& truth : scene.true_cam_from_world) {
-    const Eigen::Quaterniond rotation =
-        so3::exp(Eigen::Vector3d(noise(rng), noise(rng), noise(rng))) * truth.rotation();
-    poses.emplace_back(Pose3(rotation, -(rotation * truth.inverseTranslation())));
-  }
-  return poses;
-}
-
-PointInitialisation atPoses(const PlanarScene& scene,
-                            const std::vector<std::optional<Pose3>>& poses,
-                            const PointInitialiserOptions& options) {
-  PointInitialiser initialiser(*scene.camera, options);
-  for (const cv::Mat& image : scene.images) initialiser.addFrame(image);
-  return initialiser.finishAtPoses(poses);
 }
 
 TEST(PointInitialiser, AtGivenPosesEachPointIsRefinedOverItsViews) {

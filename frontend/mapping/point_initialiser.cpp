@@ -1121,16 +1121,21 @@ struct PointInitialiser::State {
     return true;
   }
 
-  // The median reprojection error of the tracks triangulated within given_poses_max_gate_px at
-  // the model's poses (px; 0 when none is).
-  double medianErrorAtPoses(Model model) const {
-    std::vector<double> errors;
+  // Triangulates every track at the model's poses within `gate_px` (triangulateTrackAtPoses).
+  void triangulateEveryTrackAtPoses(Model* model, double gate_px) const {
     for (int track = 0; track < static_cast<int>(tracks.tracks.size()); ++track) {
-      if (!triangulateTrackAtPoses(&model, track, options.given_poses_max_gate_px)) continue;
-      const MapPoint& point = model.points[model.point_of_track[track]];
+      triangulateTrackAtPoses(model, track, gate_px);
+    }
+  }
+
+  // The median reprojection error of the points of `model` over their views (px; 0 for none).
+  double medianErrorOfPoints(const Model& model) const {
+    std::vector<double> errors;
+    for (const MapPoint& point : model.points) {
+      if (!point.alive()) continue;
       // Every view kept lies within the gate, so every error is finite.
       for (int f : point.frames) {
-        errors.push_back(reprojectionErrorPx(model, f, pixelOf(track, f), point.position));
+        errors.push_back(reprojectionErrorPx(model, f, pixelOf(point.track, f), point.position));
       }
     }
     return errors.empty() ? 0.0 : upperMedian(errors);
@@ -1146,14 +1151,20 @@ struct PointInitialiser::State {
       return;
     }
     if (options.given_poses_gate_scale > 0.0) {
-      out.given_poses_median_error_px = medianErrorAtPoses(*model);
+      // The residuals are read on points triangulated within the widest gate; a track's point
+      // does not depend on the others', so when the gate chosen is that one the probe is the map.
+      Model probe = *model;
+      triangulateEveryTrackAtPoses(&probe, options.given_poses_max_gate_px);
+      out.given_poses_median_error_px = medianErrorOfPoints(probe);
       out.given_poses_gate_px =
           std::clamp(options.given_poses_gate_scale * out.given_poses_median_error_px,
                      options.max_reprojection_error_px, options.given_poses_max_gate_px);
+      if (out.given_poses_gate_px == options.given_poses_max_gate_px) {
+        *model = std::move(probe);
+        return;
+      }
     }
-    for (int track = 0; track < static_cast<int>(tracks.tracks.size()); ++track) {
-      triangulateTrackAtPoses(model, track, out.given_poses_gate_px);
-    }
+    triangulateEveryTrackAtPoses(model, out.given_poses_gate_px);
   }
 
   PointInitialisation finishAtPoses(const std::vector<std::optional<Pose3>>& cam_from_world) {

@@ -459,6 +459,9 @@ void addStartModelOptions(OptionsTable* table, StartModelOptions* o, const std::
       .number("reassociation_rounds", "reassociation-rounds", &o->reassociation_rounds,
               "A start tied per pose runs at most this many re-association rounds per pass "
               "(-1: --reassociation-rounds)")
+      .boolean("two_view_points", "two-view-points", &o->two_view_points,
+               "Read the start against two-view points where the BA's points are refined "
+               "(--points-refine-at-given-poses), as the scales were set")
       .number("max_reprojection_error_px", "max-reprojection-error", &o->max_reprojection_error_px,
               "PnP's inlier threshold (px)");
 }

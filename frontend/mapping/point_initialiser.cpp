@@ -1017,6 +1017,21 @@ struct PointInitialiser::State {
   // -------------------------------------------------------------------------------------------
   // Output.
 
+  std::vector<InitialisedPoint> initialisedPoints(const Model& model) const {
+    std::vector<InitialisedPoint> points;
+    for (const MapPoint& p : model.points) {
+      if (!p.alive()) continue;
+      InitialisedPoint point;
+      point.position = p.position;
+      point.colour_bgr = tracks.tracks[p.track].colour_bgr;
+      std::vector<int> frames = p.frames;
+      std::sort(frames.begin(), frames.end());
+      for (int f : frames) point.observations.push_back({f, pixelOf(p.track, f)});
+      points.push_back(std::move(point));
+    }
+    return points;
+  }
+
   // `poses_fitted`: the poses were refined with the points, not given.
   void writeResult(bool poses_fitted, const Model& merged, const std::vector<Model>& models,
                    const std::vector<int>& model_of_frame) {
@@ -1038,16 +1053,7 @@ struct PointInitialiser::State {
         frame.status = FrameRegistration::kNoCorrespondences;
       }
     }
-    for (const MapPoint& p : merged.points) {
-      if (!p.alive()) continue;
-      InitialisedPoint point;
-      point.position = p.position;
-      point.colour_bgr = tracks.tracks[p.track].colour_bgr;
-      std::vector<int> frames = p.frames;
-      std::sort(frames.begin(), frames.end());
-      for (int f : frames) point.observations.push_back({f, pixelOf(p.track, f)});
-      out.points.push_back(std::move(point));
-    }
+    out.points = initialisedPoints(merged);
     out.reprojection = reprojectionSummary(*camera, out);
     const int posed = out.registeredFrames();
     if (out.reprojection.observations > 0 && posed >= 3 && posed <= options.precision_max_frames) {
@@ -1121,6 +1127,12 @@ struct PointInitialiser::State {
     return true;
   }
 
+  // Triangulates every track as finish() does: two views each, observations within the bound.
+  void triangulateFromTwoViews(Model* model) const {
+    retriangulateAll(model);
+    filterPoints(model, allPoints(*model));
+  }
+
   // Triangulates every track at the model's poses within `gate_px` (triangulateTrackAtPoses).
   void triangulateEveryTrackAtPoses(Model* model, double gate_px) const {
     for (int track = 0; track < static_cast<int>(tracks.tracks.size()); ++track) {
@@ -1146,10 +1158,12 @@ struct PointInitialiser::State {
   void triangulateAtPoses(Model* model) {
     out.given_poses_gate_px = options.max_reprojection_error_px;
     if (!options.refine_at_given_poses) {
-      retriangulateAll(model);
-      filterPoints(model, allPoints(*model));
+      triangulateFromTwoViews(model);
       return;
     }
+    Model two_view = *model;
+    triangulateFromTwoViews(&two_view);
+    out.two_view_points = initialisedPoints(two_view);
     if (options.given_poses_gate_scale > 0.0) {
       // The residuals are read on points triangulated within the widest gate; a track's point
       // does not depend on the others', so when the gate chosen is that one the probe is the map.

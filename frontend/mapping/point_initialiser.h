@@ -307,6 +307,11 @@ struct LoopMatchStats {
 struct PointInitialisation {
   std::vector<InitialisedFrame> frames;  ///< One per frame given, in order.
   std::vector<InitialisedPoint> points;  ///< The merged map.
+  /// finishAtPoses with refine_at_given_poses: the points as they are triangulated without it
+  /// (two views each, observations within max_reprojection_error_px), which the start model
+  /// reads the start against (StartModelOptions::two_view_points); empty otherwise, when
+  /// `points` are those.
+  std::vector<InitialisedPoint> two_view_points;
   int num_tracks = 0;                    ///< Tracks of at least two frames.
   int models = 0;                        ///< Sub-models started.
   int merged_models = 0;                 ///< Of those, merged into the first (itself included).

@@ -52,9 +52,12 @@ struct FrameCorrespondences {
   std::vector<Eigen::Vector2d> pixels;
 };
 
-std::vector<FrameCorrespondences> correspondencesByFrame(const PointInitialisation& init) {
+std::vector<FrameCorrespondences> correspondencesByFrame(const PointInitialisation& init,
+                                                         bool two_view_points) {
+  const std::vector<InitialisedPoint>& points =
+      two_view_points && !init.two_view_points.empty() ? init.two_view_points : init.points;
   std::vector<FrameCorrespondences> by_frame(init.frames.size());
-  for (const InitialisedPoint& point : init.points) {
+  for (const InitialisedPoint& point : points) {
     for (const TrackObservation& o : point.observations) {
       by_frame[o.frame].points.push_back(point.position);
       by_frame[o.frame].pixels.push_back(o.pixel);
@@ -96,7 +99,8 @@ std::vector<FrameMove> measureFrameMoves(const Camera& camera, const PointInitia
   AbsolutePoseOptions pnp;
   pnp.max_reprojection_error_px = options.max_reprojection_error_px;
   pnp.min_inliers = options.min_points;
-  const std::vector<FrameCorrespondences> by_frame = correspondencesByFrame(init);
+  const std::vector<FrameCorrespondences> by_frame =
+      correspondencesByFrame(init, options.two_view_points);
   std::vector<FrameMove> moves;
   for (std::size_t f = 0; f < init.frames.size(); ++f) {
     const std::optional<Pose3>& given = init.frames[f].cam_from_world;

@@ -300,6 +300,13 @@ TEST(PointInitialiser, AtGivenPosesEachPointIsRefinedOverItsViews) {
   EXPECT_EQ(refined.given_poses_gate_px, 4.0);
   EXPECT_GE(refined.reprojection.observations, pair.reprojection.observations);
   EXPECT_LT(refined.reprojection.rms_px, 0.95 * pair.reprojection.rms_px);
+  // The start model's points are the two-view ones, whatever the BA keeps.
+  EXPECT_TRUE(pair.two_view_points.empty());
+  ASSERT_EQ(refined.two_view_points.size(), pair.points.size());
+  for (std::size_t i = 0; i < pair.points.size(); ++i) {
+    EXPECT_EQ(refined.two_view_points[i].position, pair.points[i].position);
+    EXPECT_EQ(refined.two_view_points[i].observations.size(), pair.points[i].observations.size());
+  }
 }
 
 TEST(PointInitialiser, TheGateAtGivenPosesFollowsTheirResiduals) {

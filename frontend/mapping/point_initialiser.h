@@ -145,8 +145,8 @@ struct PointInitialiserOptions {
   /// six real sets' truth starts drift less on five (KITTI 06 15.8 -> 13.0 mm) and their noise
   /// starts end level (geometric mean 0.785 against 0.780 x), but the planar noise starts ended
   /// further on 39 of 45, because the start model read the start against these points and tied
-  /// it tighter. It now reads the two-view points (StartModelOptions::two_view_points), and 29
-  /// of 39 planar runs end at or below 0.5 x against the default's 31 (session 53): level, not
+  /// it tighter. It now reads the two-view points (StartModelOptions::two_view_points), and 34
+  /// of 45 planar runs end at or below 0.5 x against the default's 36 (session 53): level, not
   /// better.
   bool refine_at_given_poses = false;
   /// At given poses, with refine_at_given_poses, the gate follows the residuals: this times the

@@ -130,8 +130,8 @@ struct StartModelOptions {
   /// scales above were set on two-view points; refined points share more of each frame's error,
   /// so on the planar scenes they read a per-pose start as off by less (box_in_scene noise seed
   /// 1: 0.033 against 0.050 spacings) and the prior ties it tighter. Planar noise starts with
-  /// refined points, 39 runs: 29 at or below 0.5 x read this way, 25 read on the refined points,
-  /// 31 with two-view points throughout (docs/benchmarks.md, session 53); Pavilion and KITTI 06
+  /// refined points, 45 runs: 34 at or below 0.5 x read this way, 30 read on the refined points,
+  /// 36 with two-view points throughout (docs/benchmarks.md, session 53); Pavilion and KITTI 06
   /// read the same within 5 % either way.
   bool two_view_points = true;
   /// PnP's inlier threshold on the reprojection error (px). Finite, > 0.

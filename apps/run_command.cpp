@@ -958,6 +958,22 @@ std::string gateText(const PointInitialisation& points, double gate_scale) {
   return text;
 }
 
+// "P % of the observations descriptor keypoints": those --ba-keypoint-sigma weighs.
+std::string keypointShareText(const std::vector<std::vector<PointSighting>>& sightings) {
+  std::size_t all = 0;
+  std::size_t keypoints = 0;
+  for (const std::vector<PointSighting>& frame : sightings) {
+    for (const PointSighting& s : frame) {
+      ++all;
+      keypoints += s.keypoint;
+    }
+  }
+  char text[80];
+  std::snprintf(text, sizeof(text), "%.0f %% of the observations descriptor keypoints",
+                all > 0 ? 100.0 * keypoints / all : 0.0);
+  return text;
+}
+
 }  // namespace
 
 RunInput RunCommand::loadInput() const {
@@ -988,6 +1004,7 @@ RunInput RunCommand::loadInput() const {
                          " tracks at the given poses" +
                          gateText(*input.initialisation, initialiser_.given_poses_gate_scale);
       if (reprojection.observations > 0) seen += "; " + reprojectionLine(reprojection);
+      seen += "; " + keypointShareText(input.sightings);
       std::printf("run: %s\n", seen.c_str());
     }
     return input;

@@ -10,6 +10,8 @@ struct PointObservation {
   int camera_index = 0;
   int point_index = 0;
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
+  /// Detected in its image on its own (a descriptor keypoint), not followed from another image.
+  bool keypoint = false;
 };
 
 }  // namespace curvesfm

@@ -72,6 +72,9 @@ void addPoints(const CurveBundleAdjustmentInput& input, const CurveBundleAdjustm
   }
   const NoiseModel noise{options.point_pixel_sigma,
                          RobustKernel(options.point_kernel, options.point_kernel_width)};
+  const NoiseModel keypoint_noise{
+      options.keypoint_pixel_sigma > 0.0 ? options.keypoint_pixel_sigma : options.point_pixel_sigma,
+      RobustKernel(options.point_kernel, options.point_kernel_width)};
   const int num_keyframes = static_cast<int>(input.cam_from_world.size());
   const int num_points = static_cast<int>(input.points.size());
   for (const PointObservation& obs : input.point_observations) {
@@ -80,7 +83,8 @@ void addPoints(const CurveBundleAdjustmentInput& input, const CurveBundleAdjustm
         << "observation of point " << obs.point_index << " in keyframe " << obs.camera_index
         << " is out of range (" << num_points << " points, " << num_keyframes << " keyframes)";
     problem->graph.emplace<PointReprojectionFactor>(
-        poseKey(obs.camera_index), pointKey(obs.point_index), obs.pixel, input.camera, noise);
+        poseKey(obs.camera_index), pointKey(obs.point_index), obs.pixel, input.camera,
+        obs.keypoint ? keypoint_noise : noise);
   }
 }
 
@@ -139,6 +143,7 @@ void CurveBundleAdjustmentOptions::validate() const {
   require.positive("start_prior_rotation_sigma_deg", start_prior_rotation_sigma_deg);
   require.positive("start_prior_centre_sigma_rel", start_prior_centre_sigma_rel);
   require.positive("point_pixel_sigma", point_pixel_sigma);
+  require.nonNegative("keypoint_pixel_sigma", keypoint_pixel_sigma);
   require.positive("point_kernel_width", point_kernel_width);
 }
 

@@ -107,6 +107,10 @@ struct CurveBundleAdjustmentOptions {
   /// Std dev of a point's reprojection residual (px); > 0. Its square against pixel_sigma's is
   /// the weight of a point observation against one curve sample.
   double point_pixel_sigma = 1.0;
+  /// Std dev of the residual of a point observed as a descriptor keypoint (px; 0: point_pixel_
+  /// sigma). A keypoint is detected in its image alone, so its error is its own, where a KLT
+  /// observation inherits the drift of the frames it was followed through. >= 0.
+  double keypoint_pixel_sigma = 0.0;
   RobustKernelType point_kernel = RobustKernelType::kHuber;  ///< Kernel on point residuals.
   double point_kernel_width = 2.0;                           ///< Kernel width in point sigmas; > 0.
 

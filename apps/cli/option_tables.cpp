@@ -370,6 +370,9 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
                "Hybrid graph: keep the initialiser's points beside the curves")
       .number("point_pixel_sigma", "point-sigma", &b->point_pixel_sigma,
               "Std dev of a point's reprojection residual (px)")
+      .number("keypoint_pixel_sigma", "keypoint-sigma", &b->keypoint_pixel_sigma,
+              "Std dev of the residual of a point seen as a descriptor keypoint, detected in its "
+              "image alone (px; 0: --ba-point-sigma)")
       .enumeration("point_kernel", "point-kernel", &b->point_kernel,
                    "Robust kernel on point residuals")
       .number("point_kernel_width", "point-kernel-width", &b->point_kernel_width,

@@ -27,11 +27,16 @@ void FeatureTrackOptions::validate() const {
   require(min_verified_matches >= 8, "min_verified_matches", min_verified_matches, ">= 8");
 }
 
-const Eigen::Vector2d* FeatureTracks::pixel(int track, int frame) const {
+const TrackObservation* FeatureTracks::observation(int track, int frame) const {
   const std::vector<TrackObservation>& obs = tracks[track].observations;
   const auto it = std::lower_bound(obs.begin(), obs.end(), frame,
                                    [](const TrackObservation& o, int f) { return o.frame < f; });
-  return it != obs.end() && it->frame == frame ? &it->pixel : nullptr;
+  return it != obs.end() && it->frame == frame ? &*it : nullptr;
+}
+
+const Eigen::Vector2d* FeatureTracks::pixel(int track, int frame) const {
+  const TrackObservation* o = observation(track, frame);
+  return o != nullptr ? &o->pixel : nullptr;
 }
 
 std::vector<int> FeatureTracks::sharedTracks(int frame_a, int frame_b) const {
@@ -314,7 +319,8 @@ struct FeatureTrackBuilder::State {
     }
     for (int k = 0; k < static_cast<int>(keypoints.size()); ++k) {
       const Keypoint& kp = keypoints[k];
-      trackOf(num_klt + k, kp.colour).observations.push_back({kp.frame, kp.pixel});
+      trackOf(num_klt + k, kp.colour)
+          .observations.push_back({kp.frame, kp.pixel, /*keypoint=*/true});
     }
 
     FeatureTracks out;

@@ -122,6 +122,8 @@ struct FeatureTracks {
   std::set<std::pair<int, int>> matched_pairs;
   /// The pixel of track `track` in frame `frame`; nullptr if the track is not seen there.
   const Eigen::Vector2d* pixel(int track, int frame) const;
+  /// Track `track`'s observation in frame `frame`; nullptr if the track is not seen there.
+  const TrackObservation* observation(int track, int frame) const;
   /// Tracks observed in both frames.
   std::vector<int> sharedTracks(int frame_a, int frame_b) const;
 };

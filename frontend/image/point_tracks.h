@@ -137,6 +137,9 @@ class PointTracker {
 struct TrackObservation {
   int frame = -1;                                   ///< Frame index (PointFrame::frame).
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  ///< Position (px).
+  /// Detected in this frame on its own (a descriptor keypoint), not followed from the frame
+  /// before (KLT, whose template drift carries each error into the next frames).
+  bool keypoint = false;
 };
 
 /// One track seen in two frames.

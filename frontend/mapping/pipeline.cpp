@@ -899,7 +899,8 @@ std::vector<int> Pipeline::Impl::addPointsTo(CurveBundleAdjustmentInput* input) 
         used.push_back(sighting.point);
         input->points.push_back(points[sighting.point] / unit());
       }
-      input->point_observations.push_back({static_cast<int>(j), i, sighting.pixel});
+      input->point_observations.push_back(
+          {static_cast<int>(j), i, sighting.pixel, sighting.keypoint});
     }
   }
   return used;

@@ -219,6 +219,7 @@ struct PipelineOptions {
 struct PointSighting {
   int point = -1;                                   ///< Index into the points given.
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  ///< Undistorted pixel (undistortedCamera()).
+  bool keypoint = false;  ///< A descriptor keypoint's pixel, not KLT's (TrackObservation).
 };
 
 struct PipelineFrame {

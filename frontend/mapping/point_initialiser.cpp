@@ -890,7 +890,7 @@ struct PointInitialiser::State {
   // The observations a loop end brings: its track's, or the keypoint alone.
   std::vector<TrackObservation> observationsOf(const LoopEnd& end) const {
     if (end.track >= 0) return tracks.tracks[end.track].observations;
-    return {{end.frame, end.pixel}};
+    return {{end.frame, end.pixel, /*keypoint=*/true}};
   }
 
   // Both ends' observations by frame; nullopt when both observe one frame (a track holds one
@@ -1026,7 +1026,7 @@ struct PointInitialiser::State {
       point.colour_bgr = tracks.tracks[p.track].colour_bgr;
       std::vector<int> frames = p.frames;
       std::sort(frames.begin(), frames.end());
-      for (int f : frames) point.observations.push_back({f, pixelOf(p.track, f)});
+      for (int f : frames) point.observations.push_back(*tracks.observation(p.track, f));
       points.push_back(std::move(point));
     }
     return points;

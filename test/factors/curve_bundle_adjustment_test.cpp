@@ -73,6 +73,15 @@ TEST(CurveBundleAdjustment, HybridGraphKeepsPointsBesideCurvesWithTheirOwnNoise)
   EXPECT_EQ(problem.values.at<Eigen::Vector3d>(pointKey(0)), point);
   // Cost 0.5 (r / sigma)^2 of the one shifted observation: 0.5 * (1 / 0.5)^2 = 2.
   EXPECT_NEAR(problem.graph.costByType(problem.values).at("point_reprojection").cost, 2.0, 1e-6);
+  // Seen as a descriptor keypoint, the shifted observation takes the keypoints' sigma:
+  // 0.5 * (1 / 0.25)^2 = 8; with that sigma 0, the points'.
+  input.point_observations[1].keypoint = true;
+  hybrid.keypoint_pixel_sigma = 0.25;
+  const CurveBundleAdjustmentProblem keypoint = buildCurveBundleAdjustment(input, hybrid);
+  EXPECT_NEAR(keypoint.graph.costByType(keypoint.values).at("point_reprojection").cost, 8.0, 1e-6);
+  hybrid.keypoint_pixel_sigma = 0.0;
+  const CurveBundleAdjustmentProblem fallback = buildCurveBundleAdjustment(input, hybrid);
+  EXPECT_NEAR(fallback.graph.costByType(fallback.values).at("point_reprojection").cost, 2.0, 1e-6);
   input.point_observations.push_back({3, 0, Eigen::Vector2d::Zero()});
   EXPECT_THROW(buildCurveBundleAdjustment(input, hybrid), CheckError);
 }
@@ -191,6 +200,9 @@ TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
   options = {};
   options.pixel_sigma = -1.0;
   expectRejected(options, "pixel_sigma");
+  options = {};
+  options.keypoint_pixel_sigma = -0.5;
+  expectRejected(options, "keypoint_pixel_sigma");
   options = {};
   options.motion_prior_rotation_sigma_deg = 0.0;
   expectRejected(options, "motion_prior_rotation_sigma_deg");

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <utility>
 #include <vector>
@@ -80,6 +81,32 @@ TEST(FeatureTracks, DescriptorsBridgeAFrameWhereKltLosesEverything) {
   FeatureTrackOptions klt_only;
   klt_only.match_overlap = 0;
   EXPECT_TRUE(build(frames, klt_only).sharedTracks(3, 5).empty());
+}
+
+// A keypoint observation is one a descriptor detected in its frame, not one KLT followed there:
+// its pixel is one of that matching frame's keypoints, and KLT alone makes none.
+TEST(FeatureTracks, MarkTheObservationsThatAreDescriptorKeypoints) {
+  const std::vector<int> frames = {0, 1, 2, 3, -1, 4, 5, 6};
+  const FeatureTracks tracks = build(frames);
+  std::vector<const FeatureSet*> features_of(frames.size(), nullptr);
+  for (const MatchingFrameFeatures& m : tracks.matching_frames) features_of[m.frame] = &m.features;
+  int keypoints = 0;
+  for (const FeatureTrack& track : tracks.tracks) {
+    for (const TrackObservation& o : track.observations) {
+      if (!o.keypoint) continue;
+      ++keypoints;
+      ASSERT_NE(features_of[o.frame], nullptr) << "keypoint in frame " << o.frame;
+      const std::vector<Eigen::Vector2d>& pixels = features_of[o.frame]->pixels;
+      EXPECT_NE(std::find(pixels.begin(), pixels.end(), o.pixel), pixels.end());
+      EXPECT_EQ(tracks.observation(&track - tracks.tracks.data(), o.frame), &o);
+    }
+  }
+  EXPECT_GT(keypoints, 20);
+  FeatureTrackOptions klt_only;
+  klt_only.match_overlap = 0;
+  for (const FeatureTrack& track : build(frames, klt_only).tracks) {
+    for (const TrackObservation& o : track.observations) EXPECT_FALSE(o.keypoint);
+  }
 }
 
 TEST(FeatureTracks, ShortSequenceMatchesEveryPairOfMatchingFrames) {

@@ -958,19 +958,25 @@ std::string gateText(const PointInitialisation& points, double gate_scale) {
   return text;
 }
 
-// "P % of the observations descriptor keypoints": those --ba-keypoint-sigma weighs.
+// "P % of the observations descriptor keypoints, median diameter D px": those
+// --ba-keypoint-sigma weighs, and the size --ba-keypoint-reference-size compares with.
 std::string keypointShareText(const std::vector<std::vector<PointSighting>>& sightings) {
   std::size_t all = 0;
-  std::size_t keypoints = 0;
+  std::vector<double> sizes;
   for (const std::vector<PointSighting>& frame : sightings) {
     for (const PointSighting& s : frame) {
       ++all;
-      keypoints += s.keypoint;
+      if (s.keypoint) sizes.push_back(s.keypoint_size);
     }
   }
-  char text[80];
-  std::snprintf(text, sizeof(text), "%.0f %% of the observations descriptor keypoints",
-                all > 0 ? 100.0 * keypoints / all : 0.0);
+  char text[120];
+  int length = std::snprintf(text, sizeof(text), "%.0f %% of the observations descriptor keypoints",
+                             all > 0 ? 100.0 * sizes.size() / all : 0.0);
+  if (!sizes.empty()) {
+    const auto middle = sizes.begin() + sizes.size() / 2;
+    std::nth_element(sizes.begin(), middle, sizes.end());
+    std::snprintf(text + length, sizeof(text) - length, ", median diameter %.1f px", *middle);
+  }
   return text;
 }
 

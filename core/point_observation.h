@@ -12,6 +12,8 @@ struct PointObservation {
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
   /// Detected in its image on its own (a descriptor keypoint), not followed from another image.
   bool keypoint = false;
+  /// The keypoint's diameter (px), the scale it was detected at; 0 when not a keypoint.
+  double keypoint_size = 0.0;
 };
 
 }  // namespace curvesfm

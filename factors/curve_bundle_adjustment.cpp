@@ -72,9 +72,15 @@ void addPoints(const CurveBundleAdjustmentInput& input, const CurveBundleAdjustm
   }
   const NoiseModel noise{options.point_pixel_sigma,
                          RobustKernel(options.point_kernel, options.point_kernel_width)};
-  const NoiseModel keypoint_noise{
-      options.keypoint_pixel_sigma > 0.0 ? options.keypoint_pixel_sigma : options.point_pixel_sigma,
-      RobustKernel(options.point_kernel, options.point_kernel_width)};
+  const double keypoint_sigma =
+      options.keypoint_pixel_sigma > 0.0 ? options.keypoint_pixel_sigma : options.point_pixel_sigma;
+  const auto keypoint_noise = [&](double size) {
+    const double relative = options.keypoint_reference_size > 0.0
+                                ? std::max(1.0, size / options.keypoint_reference_size)
+                                : 1.0;
+    return NoiseModel{keypoint_sigma * relative,
+                      RobustKernel(options.point_kernel, options.point_kernel_width)};
+  };
   const int num_keyframes = static_cast<int>(input.cam_from_world.size());
   const int num_points = static_cast<int>(input.points.size());
   for (const PointObservation& obs : input.point_observations) {
@@ -84,7 +90,7 @@ void addPoints(const CurveBundleAdjustmentInput& input, const CurveBundleAdjustm
         << " is out of range (" << num_points << " points, " << num_keyframes << " keyframes)";
     problem->graph.emplace<PointReprojectionFactor>(
         poseKey(obs.camera_index), pointKey(obs.point_index), obs.pixel, input.camera,
-        obs.keypoint ? keypoint_noise : noise);
+        obs.keypoint ? keypoint_noise(obs.keypoint_size) : noise);
   }
 }
 
@@ -144,6 +150,7 @@ void CurveBundleAdjustmentOptions::validate() const {
   require.positive("start_prior_centre_sigma_rel", start_prior_centre_sigma_rel);
   require.positive("point_pixel_sigma", point_pixel_sigma);
   require.nonNegative("keypoint_pixel_sigma", keypoint_pixel_sigma);
+  require.nonNegative("keypoint_reference_size", keypoint_reference_size);
   require.positive("point_kernel_width", point_kernel_width);
 }
 

@@ -169,7 +169,8 @@ std::vector<std::vector<PointSighting>> initialisedSightings(const PointInitiali
   std::vector<std::vector<PointSighting>> sightings(next);
   for (std::size_t p = 0; p < result.points.size(); ++p) {
     for (const TrackObservation& o : result.points[p].observations) {
-      sightings[registered_index[o.frame]].push_back({static_cast<int>(p), o.pixel, o.keypoint});
+      sightings[registered_index[o.frame]].push_back(
+          {static_cast<int>(p), o.pixel, o.keypoint, o.keypoint_size});
     }
   }
   return sightings;

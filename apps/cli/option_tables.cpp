@@ -373,6 +373,9 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
       .number("keypoint_pixel_sigma", "keypoint-sigma", &b->keypoint_pixel_sigma,
               "Std dev of the residual of a point seen as a descriptor keypoint, detected in its "
               "image alone (px; 0: --ba-point-sigma)")
+      .number("keypoint_reference_size", "keypoint-reference-size", &b->keypoint_reference_size,
+              "Keypoints larger than this diameter get the keypoint sigma x their size / it, "
+              "as their scale localises them less precisely (px; 0: size ignored)")
       .enumeration("point_kernel", "point-kernel", &b->point_kernel,
                    "Robust kernel on point residuals")
       .number("point_kernel_width", "point-kernel-width", &b->point_kernel_width,

@@ -231,11 +231,13 @@ FeatureSet detectFeatures(const cv::Mat& image, const FeatureMatchingOptions& op
                              static_cast<double>(grey.rows) / image.rows);
   set.descriptors.create(static_cast<int>(order.size()), descriptors.cols, descriptors.type());
   set.pixels.reserve(order.size());
+  set.sizes.reserve(order.size());
   for (std::size_t row = 0; row < order.size(); ++row) {
     const cv::KeyPoint& k = keypoints[static_cast<std::size_t>(order[row])];
     // Pixel centres at integers in both images: x = (x' + 0.5) / s - 0.5.
     const Eigen::Vector2d detected = keypointPixel(k, options.kind, grey.size());
     set.pixels.push_back((detected.array() + 0.5) / scale - 0.5);
+    set.sizes.push_back(k.size / scale.x());
     descriptors.row(order[row]).copyTo(set.descriptors.row(static_cast<int>(row)));
   }
   return set;

@@ -75,6 +75,9 @@ struct FeatureSet {
   /// Keypoint positions (px, pixel centres at integers), corrected for where OpenCV's detectors
   /// put them off their features (SIFT: 0.25 px right and down; ORB: its coarser levels).
   std::vector<Eigen::Vector2d> pixels;
+  /// Keypoint diameters (px of the image given; OpenCV's KeyPoint::size): the scale each was
+  /// detected at. A keypoint found at a coarser scale is localised less precisely.
+  std::vector<double> sizes;
   /// One row per keypoint: CV_32F with 128 columns (SIFT) or CV_8U with 32 columns (ORB); empty
   /// when no feature was found.
   cv::Mat descriptors;

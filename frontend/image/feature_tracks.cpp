@@ -139,6 +139,7 @@ namespace {
 struct Keypoint {
   int frame = -1;
   Eigen::Vector2d pixel;
+  double size = 0.0;
   cv::Vec3b colour;
 };
 
@@ -242,7 +243,7 @@ struct FeatureTrackBuilder::State {
     m.first_keypoint = static_cast<int>(keypoints.size());
     for (int k = 0; k < m.features.size(); ++k) {
       const Eigen::Vector2d& pixel = m.features.pixels[k];
-      keypoints.push_back({frame, pixel, colourAt(image, pixel)});
+      keypoints.push_back({frame, pixel, m.features.sizes[k], colourAt(image, pixel)});
       const int klt_track = nearestKltTrack(frame, pixel);
       if (klt_track >= 0) links.emplace_back(klt_track, keypointRef(m.first_keypoint + k));
     }
@@ -320,7 +321,7 @@ struct FeatureTrackBuilder::State {
     for (int k = 0; k < static_cast<int>(keypoints.size()); ++k) {
       const Keypoint& kp = keypoints[k];
       trackOf(num_klt + k, kp.colour)
-          .observations.push_back({kp.frame, kp.pixel, /*keypoint=*/true});
+          .observations.push_back({kp.frame, kp.pixel, /*keypoint=*/true, kp.size});
     }
 
     FeatureTracks out;

@@ -140,6 +140,8 @@ struct TrackObservation {
   /// Detected in this frame on its own (a descriptor keypoint), not followed from the frame
   /// before (KLT, whose template drift carries each error into the next frames).
   bool keypoint = false;
+  /// A keypoint's diameter (px; FeatureSet::sizes), the scale it was detected at; 0 for KLT.
+  double keypoint_size = 0.0;
 };
 
 /// One track seen in two frames.

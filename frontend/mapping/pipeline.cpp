@@ -900,7 +900,7 @@ std::vector<int> Pipeline::Impl::addPointsTo(CurveBundleAdjustmentInput* input) 
         input->points.push_back(points[sighting.point] / unit());
       }
       input->point_observations.push_back(
-          {static_cast<int>(j), i, sighting.pixel, sighting.keypoint});
+          {static_cast<int>(j), i, sighting.pixel, sighting.keypoint, sighting.keypoint_size});
     }
   }
   return used;

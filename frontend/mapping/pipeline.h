@@ -220,6 +220,7 @@ struct PointSighting {
   int point = -1;                                   ///< Index into the points given.
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  ///< Undistorted pixel (undistortedCamera()).
   bool keypoint = false;  ///< A descriptor keypoint's pixel, not KLT's (TrackObservation).
+  double keypoint_size = 0.0;  ///< The keypoint's diameter (px); 0 for KLT.
 };
 
 struct PipelineFrame {

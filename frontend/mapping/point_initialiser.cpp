@@ -801,6 +801,7 @@ struct PointInitialiser::State {
     int keypoint = -1;
     Eigen::Vector2d pixel;
     int track = -1;
+    double size = 0.0;  // The keypoint's diameter (px).
   };
   using LoopMatch = std::pair<LoopEnd, LoopEnd>;
 
@@ -875,8 +876,10 @@ struct PointInitialiser::State {
             verifiedMatches(a.features, b.features, options.features, options.tracks);
         out.loops.verified_pairs += !matches.empty();
         for (const FeatureMatch& m : matches) {
-          const LoopEnd end_a{a.frame, m.index_a, m.pixel_a, a.track_of_keypoint[m.index_a]};
-          const LoopEnd end_b{b.frame, m.index_b, m.pixel_b, b.track_of_keypoint[m.index_b]};
+          const LoopEnd end_a{a.frame, m.index_a, m.pixel_a, a.track_of_keypoint[m.index_a],
+                              a.features.sizes[m.index_a]};
+          const LoopEnd end_b{b.frame, m.index_b, m.pixel_b, b.track_of_keypoint[m.index_b],
+                              b.features.sizes[m.index_b]};
           if (end_a.track < 0 && end_b.track < 0) continue;
           if (end_a.track == end_b.track) continue;
           found.emplace_back(end_a, end_b);
@@ -890,7 +893,7 @@ struct PointInitialiser::State {
   // The observations a loop end brings: its track's, or the keypoint alone.
   std::vector<TrackObservation> observationsOf(const LoopEnd& end) const {
     if (end.track >= 0) return tracks.tracks[end.track].observations;
-    return {{end.frame, end.pixel, /*keypoint=*/true}};
+    return {{end.frame, end.pixel, /*keypoint=*/true, end.size}};
   }
 
   // Both ends' observations by frame; nullopt when both observe one frame (a track holds one

@@ -79,6 +79,16 @@ TEST(CurveBundleAdjustment, HybridGraphKeepsPointsBesideCurvesWithTheirOwnNoise)
   hybrid.keypoint_pixel_sigma = 0.25;
   const CurveBundleAdjustmentProblem keypoint = buildCurveBundleAdjustment(input, hybrid);
   EXPECT_NEAR(keypoint.graph.costByType(keypoint.values).at("point_reprojection").cost, 8.0, 1e-6);
+  // A keypoint twice the reference size doubles its sigma: 0.5 * (1 / 0.5)^2 = 2; one smaller
+  // than the reference keeps the keypoints' sigma.
+  hybrid.keypoint_reference_size = 3.0;
+  input.point_observations[1].keypoint_size = 6.0;
+  const CurveBundleAdjustmentProblem coarse = buildCurveBundleAdjustment(input, hybrid);
+  EXPECT_NEAR(coarse.graph.costByType(coarse.values).at("point_reprojection").cost, 2.0, 1e-6);
+  input.point_observations[1].keypoint_size = 2.0;
+  const CurveBundleAdjustmentProblem fine = buildCurveBundleAdjustment(input, hybrid);
+  EXPECT_NEAR(fine.graph.costByType(fine.values).at("point_reprojection").cost, 8.0, 1e-6);
+  hybrid.keypoint_reference_size = 0.0;
   hybrid.keypoint_pixel_sigma = 0.0;
   const CurveBundleAdjustmentProblem fallback = buildCurveBundleAdjustment(input, hybrid);
   EXPECT_NEAR(fallback.graph.costByType(fallback.values).at("point_reprojection").cost, 2.0, 1e-6);
@@ -203,6 +213,9 @@ TEST(CurveBundleAdjustmentOptions, ValidateNamesTheFieldAndConstraint) {
   options = {};
   options.keypoint_pixel_sigma = -0.5;
   expectRejected(options, "keypoint_pixel_sigma");
+  options = {};
+  options.keypoint_reference_size = -1.0;
+  expectRejected(options, "keypoint_reference_size");
   options = {};
   options.motion_prior_rotation_sigma_deg = 0.0;
   expectRejected(options, "motion_prior_rotation_sigma_deg");

@@ -118,6 +118,27 @@ TEST(FeatureMatching, KeypointsDetectedOnASmallerImageComeBackInFullSizePixels) 
   EXPECT_THROW(detectFeatures(scene().images[0], options), InvalidOptions);
 }
 
+// A keypoint's size is its diameter in the pixels of the image given, whatever the detection
+// scale: detected at half scale, the same keypoints as on the image halved beforehand, twice
+// the size.
+TEST(FeatureMatching, KeypointSizesAreInTheImagesPixels) {
+  cv::Mat image = scene().images[0];
+  if (image.channels() == 3) cv::cvtColor(image, image, cv::COLOR_BGR2GRAY);
+  cv::Mat half;
+  cv::resize(image, half, cv::Size(image.cols / 2, image.rows / 2), 0.0, 0.0, cv::INTER_AREA);
+  FeatureMatchingOptions options;
+  const FeatureSet on_half = detectFeatures(half, options);
+  options.detection_scale = 0.5;
+  const FeatureSet scaled = detectFeatures(image, options);
+  ASSERT_GT(scaled.size(), 20);
+  ASSERT_EQ(scaled.sizes.size(), scaled.pixels.size());
+  ASSERT_EQ(on_half.size(), scaled.size());
+  for (int k = 0; k < scaled.size(); ++k) {
+    EXPECT_GT(on_half.sizes[k], 0.0);
+    EXPECT_DOUBLE_EQ(scaled.sizes[k], 2.0 * on_half.sizes[k]);
+  }
+}
+
 // Half the mean offset between each keypoint of `image` and the nearest keypoint of the image
 // turned by 180 deg, mapped back (within 1 px): the detector's bias. A detector without one finds
 // a feature at the same place in both images; OpenCV's SIFT alone puts both 0.25 px right of and

@@ -97,7 +97,10 @@ TEST(FeatureTracks, MarkTheObservationsThatAreDescriptorKeypoints) {
       ++keypoints;
       ASSERT_NE(features_of[o.frame], nullptr) << "keypoint in frame " << o.frame;
       const std::vector<Eigen::Vector2d>& pixels = features_of[o.frame]->pixels;
-      EXPECT_NE(std::find(pixels.begin(), pixels.end(), o.pixel), pixels.end());
+      const auto found = std::find(pixels.begin(), pixels.end(), o.pixel);
+      ASSERT_NE(found, pixels.end());
+      // It keeps the scale its keypoint was detected at.
+      EXPECT_EQ(o.keypoint_size, features_of[o.frame]->sizes[found - pixels.begin()]);
       EXPECT_EQ(tracks.observation(&track - tracks.tracks.data(), o.frame), &o);
     }
   }
@@ -105,7 +108,10 @@ TEST(FeatureTracks, MarkTheObservationsThatAreDescriptorKeypoints) {
   FeatureTrackOptions klt_only;
   klt_only.match_overlap = 0;
   for (const FeatureTrack& track : build(frames, klt_only).tracks) {
-    for (const TrackObservation& o : track.observations) EXPECT_FALSE(o.keypoint);
+    for (const TrackObservation& o : track.observations) {
+      EXPECT_FALSE(o.keypoint);
+      EXPECT_EQ(o.keypoint_size, 0.0);
+    }
   }
 }
 

@@ -2,24 +2,27 @@
 // dataset with ground-truth poses.
 //
 // Each image's features are detected as the initialiser detects them (detectFeatures, default
-// FeatureMatchingOptions: SIFT, 1000 features) and matched (ratio test, mutual check) with the
-// next --pair-gap images. A match's error is its distance from the true epipolar lines (the mean
-// of both images', in undistorted pixels) under the ground truth's relative pose: the component
-// of the two keypoints' location errors across the epipolar line, with no fitted model in it.
-// Matches farther than --max-distance px are taken for wrong ones and left out. The matches are
-// binned by the larger of the two keypoint diameters (FeatureSet::sizes), half an octave a bin.
-// The figure the hybrid graph's --ba-keypoint-reference-size weighs by: a keypoint detected at a
-// coarser scale is localised less precisely.
+// FeatureMatchingOptions: SIFT, 1000 features) and matched with the next --pair-gap images
+// (matchFeatures: ratio test, mutual check). Where the initialiser verifies matches by RANSAC,
+// the bench gates them by the true geometry instead (below). A match's error is its distance from
+// the true epipolar lines (the mean of both images', in undistorted pixels) under the ground
+// truth's relative pose: the component of the two keypoints' location errors across the epipolar
+// line, with no fitted model in it. Matches farther than --max-distance px are taken for wrong ones
+// and left out. The matches are binned by the larger of the two keypoint diameters
+// (FeatureSet::sizes), half an octave a bin. The figure the hybrid graph's
+// --ba-keypoint-reference-size weighs by: a keypoint detected at a coarser scale is localised less
+// precisely.
 //
 // Output: `key: value` lines (matches, median distance overall) and one line per size bin.
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
-#include <optional>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,9 +80,9 @@ double epipolarDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 Eigen::Matrix3d trueFundamental(const Pose3& a, const Pose3& b, const Camera& camera) {
   const Pose3 b_from_a = b * a.inverse();
   const Eigen::Matrix3d essential = so3::hat(b_from_a.translation()) * b_from_a.rotationMatrix();
-  Eigen::Matrix3d k = Eigen::Matrix3d::Identity();
-  k << camera.fx(), 0.0, camera.intrinsics().cx, 0.0, camera.intrinsics().fy,
-      camera.intrinsics().cy, 0.0, 0.0, 1.0;
+  const CameraIntrinsics& c = camera.intrinsics();
+  Eigen::Matrix3d k;
+  k << c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0;
   const Eigen::Matrix3d k_inverse = k.inverse();
   return k_inverse.transpose() * essential * k_inverse;
 }
@@ -99,7 +102,10 @@ int run(const KeypointBenchOptions& o) {
   for (std::size_t i = 0; i < sequence.images.size(); ++i) {
     if (!poses[i]) continue;
     PosedFeatures p;
-    p.features = detectFeatures(cv::imread(sequence.images[i].image_path), matching);
+    const std::string& path = sequence.images[i].image_path;
+    const cv::Mat image = cv::imread(path);
+    if (image.empty()) throw IoError(path, "not an image OpenCV can read");
+    p.features = detectFeatures(image, matching);
     for (const Eigen::Vector2d& pixel : p.features.pixels) {
       p.undistorted.push_back(sequence.camera.undistortPixel(pixel));
     }

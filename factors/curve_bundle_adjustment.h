@@ -114,8 +114,9 @@ struct CurveBundleAdjustmentOptions {
   /// Keypoints larger than this diameter (px; 0: every keypoint alike) get a sigma grown with
   /// their size: keypoint sigma x size / keypoint_reference_size, as ORB-SLAM weighs a keypoint
   /// by its pyramid level. A keypoint found at a coarser scale is localised less precisely: SIFT
-  /// matches under the true poses of templeRing lie 0.08 px from their epipolar lines at 2 px,
-  /// 0.18 at 5, 0.44 at 11 and 0.70 at 22 (docs/benchmarks.md, session 55). >= 0.
+  /// matches under the true poses of templeRing lie 0.07 px from their epipolar lines at 2 px,
+  /// 0.18 at 5, 0.43 at 11 and 0.68 at 22 (docs/benchmarks.md, session 55). The sizes are SIFT
+  /// diameters; ORB's are its 31 px patch at each level, so it needs a reference of its own. >= 0.
   double keypoint_reference_size = 0.0;
   RobustKernelType point_kernel = RobustKernelType::kHuber;  ///< Kernel on point residuals.
   double point_kernel_width = 2.0;                           ///< Kernel width in point sigmas; > 0.

@@ -375,7 +375,8 @@ void addCurveBundleAdjustmentOptions(OptionsTable* table, CurveBundleAdjustmentO
               "image alone (px; 0: --ba-point-sigma)")
       .number("keypoint_reference_size", "keypoint-reference-size", &b->keypoint_reference_size,
               "Keypoints larger than this diameter get the keypoint sigma x their size / it, "
-              "as their scale localises them less precisely (px; 0: size ignored)")
+              "as their scale localises them less precisely (px, SIFT's diameters; ORB's are "
+              "its 31 px patch per level; 0: size ignored)")
       .enumeration("point_kernel", "point-kernel", &b->point_kernel,
                    "Robust kernel on point residuals")
       .number("point_kernel_width", "point-kernel-width", &b->point_kernel_width,

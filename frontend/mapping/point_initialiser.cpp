@@ -374,6 +374,8 @@ struct PointInitialiser::State {
       const MapPoint& point = model->points[p];
       const int index = static_cast<int>(input.points.size());
       input.points.push_back(point.position);
+      // Every observation weighs alike, as in COLMAP: weighing keypoints by their size made the
+      // initialiser's ATE worse on four of six real sets (docs/benchmarks.md, session 55).
       for (int f : point.frames) {
         input.observations.push_back({camera_index.at(f), index, pixelOf(point.track, f)});
       }
@@ -801,7 +803,7 @@ struct PointInitialiser::State {
     int keypoint = -1;
     Eigen::Vector2d pixel;
     int track = -1;
-    double size = 0.0;  // The keypoint's diameter (px).
+    double size = 0.0;  // The keypoint's diameter (px), for the hybrid graph's keypoint weight.
   };
   using LoopMatch = std::pair<LoopEnd, LoopEnd>;
 

@@ -88,6 +88,16 @@ TEST(CurveBundleAdjustment, HybridGraphKeepsPointsBesideCurvesWithTheirOwnNoise)
   input.point_observations[1].keypoint_size = 2.0;
   const CurveBundleAdjustmentProblem fine = buildCurveBundleAdjustment(input, hybrid);
   EXPECT_NEAR(fine.graph.costByType(fine.values).at("point_reprojection").cost, 8.0, 1e-6);
+  // Without a keypoint sigma the size grows the points' sigma, 0.5 px x 6 / 3: 0.5 * (1 / 1)^2. A
+  // KLT observation keeps the points' sigma whatever size it carries.
+  hybrid.keypoint_pixel_sigma = 0.0;
+  input.point_observations[1].keypoint_size = 6.0;
+  const CurveBundleAdjustmentProblem grown = buildCurveBundleAdjustment(input, hybrid);
+  EXPECT_NEAR(grown.graph.costByType(grown.values).at("point_reprojection").cost, 0.5, 1e-6);
+  input.point_observations[1].keypoint = false;
+  const CurveBundleAdjustmentProblem klt = buildCurveBundleAdjustment(input, hybrid);
+  EXPECT_NEAR(klt.graph.costByType(klt.values).at("point_reprojection").cost, 2.0, 1e-6);
+  input.point_observations[1].keypoint = true;
   hybrid.keypoint_reference_size = 0.0;
   hybrid.keypoint_pixel_sigma = 0.0;
   const CurveBundleAdjustmentProblem fallback = buildCurveBundleAdjustment(input, hybrid);

@@ -970,12 +970,12 @@ std::string keypointShareText(const std::vector<std::vector<PointSighting>>& sig
     }
   }
   char text[120];
-  int length = std::snprintf(text, sizeof(text), "%.0f %% of the observations descriptor keypoints",
-                             all > 0 ? 100.0 * sizes.size() / all : 0.0);
+  const int length =
+      std::snprintf(text, sizeof(text), "%.0f %% of the observations descriptor keypoints",
+                    all > 0 ? 100.0 * sizes.size() / all : 0.0);
   if (!sizes.empty()) {
-    const auto middle = sizes.begin() + sizes.size() / 2;
-    std::nth_element(sizes.begin(), middle, sizes.end());
-    std::snprintf(text + length, sizeof(text) - length, ", median diameter %.1f px", *middle);
+    std::snprintf(text + length, sizeof(text) - length, ", median diameter %.1f px",
+                  upperMedian(sizes));
   }
   return text;
 }

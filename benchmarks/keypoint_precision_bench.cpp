@@ -22,7 +22,6 @@
 #include <map>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,7 +31,7 @@
 #include "core/image_sequence.h"
 #include "core/pose3.h"
 #include "core/so3.h"
-#include "core/timestamp_association.h"
+#include "core/tum_dataset.h"
 #include "frontend/image/feature_matching.h"
 
 namespace curvesfm {
@@ -55,17 +54,6 @@ struct PosedFeatures {
   Pose3 cam_from_world;
 };
 
-// Ground truth per image: one pose per image, or TUM's and EuRoC's associated by timestamp.
-std::vector<std::optional<Pose3>> truePoses(const ImageSequence& sequence, double max_dt) {
-  std::vector<StampedPose> stamps;
-  for (const SequenceImage& image : sequence.images) stamps.push_back({image.timestamp, {}});
-  std::vector<std::optional<Pose3>> poses(sequence.images.size());
-  for (const TimestampMatch& m : associateByTimestamp(stamps, sequence.ground_truth, max_dt)) {
-    poses[m.estimate_index] = sequence.ground_truth[m.ground_truth_index].world_from_cam.inverse();
-  }
-  return poses;
-}
-
 // Distance of a match from the true epipolar lines (px, mean of both images').
 double epipolarDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                         const Eigen::Matrix3d& fundamental) {
@@ -80,10 +68,7 @@ double epipolarDistance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 Eigen::Matrix3d trueFundamental(const Pose3& a, const Pose3& b, const Camera& camera) {
   const Pose3 b_from_a = b * a.inverse();
   const Eigen::Matrix3d essential = so3::hat(b_from_a.translation()) * b_from_a.rotationMatrix();
-  const CameraIntrinsics& c = camera.intrinsics();
-  Eigen::Matrix3d k;
-  k << c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0;
-  const Eigen::Matrix3d k_inverse = k.inverse();
+  const Eigen::Matrix3d k_inverse = camera.K().inverse();
   return k_inverse.transpose() * essential * k_inverse;
 }
 
@@ -95,21 +80,21 @@ int run(const KeypointBenchOptions& o) {
   read.max_frames = o.max_frames;
   const ImageSequence sequence = loadImageSequence(o.dataset, read);
   if (sequence.ground_truth.empty()) throw IoError(o.dataset, "the dataset has no ground truth");
-  const std::vector<std::optional<Pose3>> poses = truePoses(sequence, o.max_dt_s);
+  // One pose per image, or TUM's and EuRoC's associated by timestamp.
+  const std::vector<DatasetFrame> frames =
+      framesWithPoses(sequence, sequence.ground_truth, o.max_dt_s, sequence.ground_truth_source);
 
   std::vector<PosedFeatures> images;
   const FeatureMatchingOptions matching;
-  for (std::size_t i = 0; i < sequence.images.size(); ++i) {
-    if (!poses[i]) continue;
+  for (const DatasetFrame& frame : frames) {
     PosedFeatures p;
-    const std::string& path = sequence.images[i].image_path;
-    const cv::Mat image = cv::imread(path);
-    if (image.empty()) throw IoError(path, "not an image OpenCV can read");
+    const cv::Mat image = cv::imread(frame.image_path);
+    if (image.empty()) throw IoError(frame.image_path, "not an image OpenCV can read");
     p.features = detectFeatures(image, matching);
     for (const Eigen::Vector2d& pixel : p.features.pixels) {
       p.undistorted.push_back(sequence.camera.undistortPixel(pixel));
     }
-    p.cam_from_world = *poses[i];
+    p.cam_from_world = frame.initial_cam_from_world;
     images.push_back(std::move(p));
   }
   std::fprintf(stderr, "%zu posed images of %zu\n", images.size(), sequence.images.size());

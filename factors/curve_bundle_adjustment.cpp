@@ -70,16 +70,15 @@ void addPoints(const CurveBundleAdjustmentInput& input, const CurveBundleAdjustm
   for (std::size_t p = 0; p < input.points.size(); ++p) {
     problem->values.insert(pointKey(p), input.points[p]);
   }
-  const NoiseModel noise{options.point_pixel_sigma,
-                         RobustKernel(options.point_kernel, options.point_kernel_width)};
+  const RobustKernel kernel(options.point_kernel, options.point_kernel_width);
+  const NoiseModel noise{options.point_pixel_sigma, kernel};
   const double keypoint_sigma =
       options.keypoint_pixel_sigma > 0.0 ? options.keypoint_pixel_sigma : options.point_pixel_sigma;
   const auto keypoint_noise = [&](double size) {
     const double relative = options.keypoint_reference_size > 0.0
                                 ? std::max(1.0, size / options.keypoint_reference_size)
                                 : 1.0;
-    return NoiseModel{keypoint_sigma * relative,
-                      RobustKernel(options.point_kernel, options.point_kernel_width)};
+    return NoiseModel{keypoint_sigma * relative, kernel};
   };
   const int num_keyframes = static_cast<int>(input.cam_from_world.size());
   const int num_points = static_cast<int>(input.points.size());

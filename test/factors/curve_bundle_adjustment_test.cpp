@@ -73,35 +73,33 @@ TEST(CurveBundleAdjustment, HybridGraphKeepsPointsBesideCurvesWithTheirOwnNoise)
   EXPECT_EQ(problem.values.at<Eigen::Vector3d>(pointKey(0)), point);
   // Cost 0.5 (r / sigma)^2 of the one shifted observation: 0.5 * (1 / 0.5)^2 = 2.
   EXPECT_NEAR(problem.graph.costByType(problem.values).at("point_reprojection").cost, 2.0, 1e-6);
+  const auto pointCost = [&] {
+    const CurveBundleAdjustmentProblem built = buildCurveBundleAdjustment(input, hybrid);
+    return built.graph.costByType(built.values).at("point_reprojection").cost;
+  };
   // Seen as a descriptor keypoint, the shifted observation takes the keypoints' sigma:
   // 0.5 * (1 / 0.25)^2 = 8; with that sigma 0, the points'.
   input.point_observations[1].keypoint = true;
   hybrid.keypoint_pixel_sigma = 0.25;
-  const CurveBundleAdjustmentProblem keypoint = buildCurveBundleAdjustment(input, hybrid);
-  EXPECT_NEAR(keypoint.graph.costByType(keypoint.values).at("point_reprojection").cost, 8.0, 1e-6);
+  EXPECT_NEAR(pointCost(), 8.0, 1e-6);
   // A keypoint twice the reference size doubles its sigma: 0.5 * (1 / 0.5)^2 = 2; one smaller
   // than the reference keeps the keypoints' sigma.
   hybrid.keypoint_reference_size = 3.0;
   input.point_observations[1].keypoint_size = 6.0;
-  const CurveBundleAdjustmentProblem coarse = buildCurveBundleAdjustment(input, hybrid);
-  EXPECT_NEAR(coarse.graph.costByType(coarse.values).at("point_reprojection").cost, 2.0, 1e-6);
+  EXPECT_NEAR(pointCost(), 2.0, 1e-6);
   input.point_observations[1].keypoint_size = 2.0;
-  const CurveBundleAdjustmentProblem fine = buildCurveBundleAdjustment(input, hybrid);
-  EXPECT_NEAR(fine.graph.costByType(fine.values).at("point_reprojection").cost, 8.0, 1e-6);
+  EXPECT_NEAR(pointCost(), 8.0, 1e-6);
   // Without a keypoint sigma the size grows the points' sigma, 0.5 px x 6 / 3: 0.5 * (1 / 1)^2. A
   // KLT observation keeps the points' sigma whatever size it carries.
   hybrid.keypoint_pixel_sigma = 0.0;
   input.point_observations[1].keypoint_size = 6.0;
-  const CurveBundleAdjustmentProblem grown = buildCurveBundleAdjustment(input, hybrid);
-  EXPECT_NEAR(grown.graph.costByType(grown.values).at("point_reprojection").cost, 0.5, 1e-6);
+  EXPECT_NEAR(pointCost(), 0.5, 1e-6);
   input.point_observations[1].keypoint = false;
-  const CurveBundleAdjustmentProblem klt = buildCurveBundleAdjustment(input, hybrid);
-  EXPECT_NEAR(klt.graph.costByType(klt.values).at("point_reprojection").cost, 2.0, 1e-6);
+  EXPECT_NEAR(pointCost(), 2.0, 1e-6);
   input.point_observations[1].keypoint = true;
   hybrid.keypoint_reference_size = 0.0;
   hybrid.keypoint_pixel_sigma = 0.0;
-  const CurveBundleAdjustmentProblem fallback = buildCurveBundleAdjustment(input, hybrid);
-  EXPECT_NEAR(fallback.graph.costByType(fallback.values).at("point_reprojection").cost, 2.0, 1e-6);
+  EXPECT_NEAR(pointCost(), 2.0, 1e-6);
   input.point_observations.push_back({3, 0, Eigen::Vector2d::Zero()});
   EXPECT_THROW(buildCurveBundleAdjustment(input, hybrid), CheckError);
 }

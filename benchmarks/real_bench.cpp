@@ -220,6 +220,10 @@ struct Row {
   /// reprojection.precision.predicted_centre_ate, in the row's own unit until evaluate() scales
   /// it to the ground truth's): how far the points fix the trajectory at all. NaN without.
   double points_ate_floor = std::nan("");
+  /// The same from the curves' edge noise after the run's last BA (report.json curve_precision),
+  /// samples independent and correlated along each observation; NaN without.
+  double curves_ate_floor = std::nan("");
+  double curves_ate_floor_correlated = std::nan("");
   // Wall times (s); NaN where the variant has no such stage.
   double tracks_s = std::nan("");
   /// Tracks per frame scaled to 640x480 (ms, wall time on Options::tracking_threads).
@@ -305,6 +309,8 @@ void evaluate(const std::vector<StampedPose>& estimate, const ImageSequence& seq
     row->evaluated = e.ate.count;
     row->ate = e.ate;
     row->points_ate_floor *= e.ground_truth_from_estimate.scale;
+    row->curves_ate_floor *= e.ground_truth_from_estimate.scale;
+    row->curves_ate_floor_correlated *= e.ground_truth_from_estimate.scale;
     row->rpe = e.rpe_translation_stats;
     std::vector<StampedPose> aligned;
     for (const MatchedPose& m : e.matches) {
@@ -321,18 +327,21 @@ double number(const nlohmann::json& json, const std::string& key) {
   return json.contains(key) && json[key].is_number() ? json[key].get<double>() : std::nan("");
 }
 
+// A predicted ATE of a report: a number, "infinite" where nothing fixes a centre, else NaN.
+double predictedAte(const nlohmann::json& ate) {
+  return ate.is_number()   ? ate.get<double>()
+         : ate.is_string() ? std::numeric_limits<double>::infinity()
+                           : std::nan("");
+}
+
 // The initialiser's part of a report.json (init: the top level; run: "initialiser"): its times,
 // counts and the points' floor.
 void readInitialiser(const nlohmann::json& part, Row* row) {
   if (!part.is_object() || !part.contains("seconds")) return;
   const nlohmann::json precision =
       part.value("reprojection", nlohmann::json::object()).value("precision", nlohmann::json());
-  if (precision.is_object()) {
-    const nlohmann::json& ate = precision["predicted_centre_ate"];
-    row->points_ate_floor = ate.is_number()   ? ate.get<double>()
-                            : ate.is_string() ? std::numeric_limits<double>::infinity()
-                                              : std::nan("");
-  }
+  if (precision.is_object())
+    row->points_ate_floor = predictedAte(precision["predicted_centre_ate"]);
   const nlohmann::json& s = part["seconds"];
   row->tracks_s = number(s, "undistort") + number(s, "klt") + number(s, "matching");
   row->tracks_ms = number(s, "tracks_ms_per_640x480_frame");
@@ -461,6 +470,11 @@ void runCurvesfm(const BenchOptions& options, const Variant& variant, const Real
                                       .value("curve_reprojection", nlohmann::json());
     if (curves.is_object() && number(curves, "count") > 0.0) {
       row->curve_cost_per_observation = number(curves, "cost") / number(curves, "count");
+    }
+    const nlohmann::json precision = report.value("curve_precision", nlohmann::json());
+    if (precision.is_object()) {
+      row->curves_ate_floor = predictedAte(precision["predicted_centre_ate"]);
+      row->curves_ate_floor_correlated = predictedAte(precision["predicted_centre_ate_correlated"]);
     }
   }
   if (r.exit_code != 0) {
@@ -731,7 +745,8 @@ void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
   out << "set,variant,start,repetition,status,frames,registered,evaluated,start_ate_rmse,ate_rmse,"
          "ate_mean,"
          "ate_median,map_precision_2cm,map_recall_2cm,curve_cost_per_observation,"
-         "points_ate_floor,rpe_translation_rmse,tracks_s,tracks_ms_per_640x480_frame,init_s,curves_"
+         "points_ate_floor,curves_ate_floor,curves_ate_floor_correlated,rpe_translation_rmse,"
+         "tracks_s,tracks_ms_per_640x480_frame,init_s,curves_"
          "s,local_ba_s,"
          "global_ba_s,extraction_s,"
          "matching_s,mapping_s,total_s,note\n";
@@ -746,6 +761,8 @@ void writeCsv(const std::vector<Row>& rows, const fs::path& path) {
         << formatNumber(r.map_precision, "%.4g") << "," << formatNumber(r.map_recall, "%.4g") << ","
         << formatNumber(r.curve_cost_per_observation, "%.6g") << ","
         << formatNumber(ok ? r.points_ate_floor : nan, "%.6g") << ","
+        << formatNumber(ok ? r.curves_ate_floor : nan, "%.6g") << ","
+        << formatNumber(ok ? r.curves_ate_floor_correlated : nan, "%.6g") << ","
         << formatNumber(ok && r.rpe.count > 0 ? r.rpe.rmse : nan, "%.9g") << ","
         << formatNumber(r.tracks_s, "%.6g") << "," << formatNumber(r.tracks_ms, "%.6g") << ","
         << formatNumber(r.init_s, "%.6g") << "," << formatNumber(r.curves_s, "%.6g") << ","
@@ -778,8 +795,11 @@ std::string markdownRow(const Row& r) {
        << " | " << formatNumber(ok ? r.ate.rmse : nan) << " | "
        << formatNumber(ok && r.start != "truth" ? r.ate.rmse / r.start_ate : nan, "%.3f") << " | "
        << formatNumber(ok ? r.points_ate_floor : nan) << " | "
-       << formatNumber(ok ? r.ate.mean : nan) << " | " << formatNumber(ok ? r.ate.median : nan)
-       << " | "
+       << (ok && !std::isnan(r.curves_ate_floor) ? formatNumber(r.curves_ate_floor) + " - " +
+                                                       formatNumber(r.curves_ate_floor_correlated)
+                                                 : "")
+       << " | " << formatNumber(ok ? r.ate.mean : nan) << " | "
+       << formatNumber(ok ? r.ate.median : nan) << " | "
        << (std::isnan(r.map_precision)
                ? ""
                : formatNumber(r.map_precision, "%.3f") + " / " + formatNumber(r.map_recall, "%.3f"))
@@ -795,7 +815,8 @@ std::string markdownRow(const Row& r) {
 std::string markdownTable(const std::vector<Row>& rows, int tracking_threads) {
   std::ostringstream out;
   out << "| set | variant | start | registered | evaluated | start ATE | ATE rmse | ATE / start "
-         "| points' ATE floor | ATE mean | ATE median | map P / R at 2 cm | RPE t rmse "
+         "| points' ATE floor | curves' ATE floor (independent - correlated) | ATE mean | ATE "
+         "median | map P / R at 2 cm | RPE t rmse "
          "| tracks s | tracks ms per 640x480 frame, "
       << (tracking_threads == 1 ? std::string("one core")
                                 : std::to_string(tracking_threads) + " threads")
@@ -803,7 +824,7 @@ std::string markdownTable(const std::vector<Row>& rows, int tracking_threads) {
          "global BA s | COLMAP extract / match / "
          "map s | total s | note |\n"
          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-         "\n";
+         "---|\n";
   for (const Row& r : rows) out << markdownRow(r) << "\n";
   return out.str();
 }

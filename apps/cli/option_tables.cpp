@@ -508,6 +508,10 @@ void addPipelineOptions(OptionsTable* table, PipelineOptions* o, const std::stri
       .number("last_global_ba_kernel_width", "last-global-ba-kernel-width",
               &o->last_global_ba_kernel_width,
               "Kernel width of the last global BA (sigmas; 0: --ba-kernel-width)")
+      .number("curve_precision_max_keyframes", "curve-precision-max-keyframes",
+              &o->curve_precision_max_keyframes,
+              "The centres' precision from the curves' edge noise after the last global BA, for "
+              "runs of at most this many keyframes (0: never)")
       .boolean("reassociation_skip_explained", "reassociation-skip-explained",
                &o->reassociation_skip_explained,
                "Re-association leaves edges that curves observed in a keyframe already explain")

@@ -310,6 +310,8 @@ void PipelineOptions::validate() const {
           point_depth_margin, "finite and >= 1");
   require(std::isfinite(scene_scale) && scene_scale >= 0.0, "scene_scale", scene_scale,
           "must be finite and >= 0 (0 derives it)");
+  require(curve_precision_max_keyframes >= 0, "curve_precision_max_keyframes",
+          curve_precision_max_keyframes, ">= 0");
   require(last_global_ba_kernel_width == 0.0 ||
               (std::isfinite(last_global_ba_kernel_width) && last_global_ba_kernel_width > 0.0),
           "last_global_ba_kernel_width", last_global_ba_kernel_width,
@@ -398,6 +400,7 @@ struct Pipeline::Impl {
   EpipolarDepthOptions depthOptions(int k) const;
   PoseStage poseStage(const std::string& name) const;
   std::vector<CurveStatistics> curveStatisticsInPoseUnits() const;
+  std::optional<CurveCentrePrecision> curvePrecisionInPoseUnits() const;
   void initialiseCurves(int k, const std::vector<EdgeChain>& chains, KeyframeStats* stats);
   std::vector<OpenEnd> openEnds(int k) const;
   void addInitialCurve(int k, const InitialCurve& initial, const ChainDepths& depths,
@@ -728,6 +731,23 @@ std::vector<CurveStatistics> Pipeline::Impl::curveStatisticsInPoseUnits() const 
     stats[c].first_keyframe = map.curve(ids[c]).first_keyframe;
   }
   return stats;
+}
+
+// How precisely the final map's curves fix the centres, weighed as the last global BA weighs
+// them; ATEs back in pose units.
+std::optional<CurveCentrePrecision> Pipeline::Impl::curvePrecisionInPoseUnits() const {
+  const int n = static_cast<int>(keyframes.size());
+  if (global_bas == 0 || n < 3 || n > options.curve_precision_max_keyframes) return std::nullopt;
+  std::vector<int> ids;
+  const CurveBundleAdjustmentInput input = bundleInput(CurveSelection::kPromoted, &ids);
+  if (input.observations.empty()) return std::nullopt;
+  CurveBundleAdjustmentOptions ba = options.ba;
+  if (options.last_global_ba_kernel_width > 0.0)
+    ba.kernel_width = options.last_global_ba_kernel_width;
+  CurveCentrePrecision precision = curveCentrePrecision(buildCurveBundleAdjustment(input, ba), n);
+  precision.predicted_centre_ate *= unit();
+  precision.predicted_centre_ate_correlated *= unit();
+  return precision;
 }
 
 // The depth range of keyframe k's epipolar search: from the points it sees when there are
@@ -1196,6 +1216,7 @@ void Pipeline::Impl::collectResult(int promoted, PipelineResult* result) const {
     result->curves.push_back(scaledCurve(curve, pose_unit));
   }
   result->curve_statistics = curveStatisticsInPoseUnits();
+  result->curve_precision = curvePrecisionInPoseUnits();
   if (options.ba.points) result->points = points;
   result->frames = frames;
 

@@ -11,6 +11,7 @@
 #include "core/camera.h"
 #include "core/pose3.h"
 #include "factors/curve_bundle_adjustment.h"
+#include "factors/curve_precision.h"
 #include "factors/curve_statistics.h"
 #include "frontend/image/correspondence_checks.h"
 #include "frontend/image/curve_extension.h"
@@ -150,6 +151,12 @@ struct PipelineOptions {
   /// cases refined; docs/benchmarks.md, "A narrower kernel for the last global BA" and "The
   /// narrow last kernel by default"). Finite and > 0, or 0.
   double last_global_ba_kernel_width = 1.0;
+  /// After the last global BA, how precisely the curves fix the camera centres
+  /// (factors/curve_precision.h: the ATE the edge noise alone would leave), for runs of at most
+  /// this many keyframes: it costs one linearisation of every edge factor and an
+  /// eigen-decomposition of 6 x keyframes rows (about as much as one BA iteration at 100
+  /// keyframes). >= 0; 0: never.
+  int curve_precision_max_keyframes = 200;
   /// Re-association leaves a keyframe's edges to the curves already observed there: a segment
   /// whose projection lies mostly (over half its samples) within explained_radius_px of the
   /// projection of a segment observed in that keyframe is not registered there, nor are two
@@ -357,6 +364,9 @@ struct PipelineResult {
   /// The scene's extent, the implausible curves (those dropped are not in `curves`), the largest
   /// pose move and the verdicts; lengths in pose units.
   RunSanity sanity;
+  /// How precisely the final map's curves fix the centres (PipelineOptions::
+  /// curve_precision_max_keyframes), its ATEs in pose units; empty when not computed.
+  std::optional<CurveCentrePrecision> curve_precision;
 
   /// Wall time of the first global BA and of the re-association rounds' (s).
   double globalBaSeconds() const;

@@ -110,6 +110,18 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
   EXPECT_EQ(report["final_fit"], last_costs);
   EXPECT_GT(report["final_fit"]["curve_reprojection"]["count"].get<int>(), 0);
   EXPECT_THAT(result.output, HasSubstr("fit: curve cost "));
+  // How precisely that map's curves fix the centres, from the residuals of the same state.
+  const nlohmann::json& precision = report["curve_precision"];
+  ASSERT_TRUE(precision.is_object());
+  EXPECT_GT(precision["samples"].get<int>(), precision["observations"].get<int>());
+  EXPECT_GT(precision["pixel_sigma"].get<double>(), 0.0);
+  ASSERT_TRUE(precision["predicted_centre_ate"].is_number());
+  EXPECT_GT(precision["predicted_centre_ate"].get<double>(), 0.0);
+  if (precision["sample_correlation"].get<double>() > 0.0) {
+    EXPECT_GT(precision["predicted_centre_ate_correlated"].get<double>(),
+              precision["predicted_centre_ate"].get<double>());
+  }
+  EXPECT_THAT(result.output, HasSubstr("curves' precision: their edge noise"));
   EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));
   // Keyframe 5's local BA refined the curves its window observes.
   EXPECT_GT(report["frames"][5]["local_ba_iterations"].get<int>(), 0);

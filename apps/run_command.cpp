@@ -506,7 +506,8 @@ void printCurvePrecision(const std::optional<CurveCentrePrecision>& precision,
     std::printf(", %.3g to %.3g in the ground truth's", scale * precision->predicted_centre_ate,
                 scale * precision->predicted_centre_ate_correlated);
   }
-  std::printf(" (a floor: no bias, no wrong edge; report.json curve_precision)\n");
+  std::printf(" (a floor: no bias, no wrong edge; %.1f s; report.json curve_precision)\n",
+              precision->seconds);
 }
 
 nlohmann::json curvePrecisionJson(const std::optional<CurveCentrePrecision>& precision) {
@@ -520,7 +521,8 @@ nlohmann::json curvePrecisionJson(const std::optional<CurveCentrePrecision>& pre
           {"pixel_sigma", precision->pixel_sigma},
           {"sample_correlation", precision->sample_correlation},
           {"predicted_centre_ate", ate(precision->predicted_centre_ate)},
-          {"predicted_centre_ate_correlated", ate(precision->predicted_centre_ate_correlated)}};
+          {"predicted_centre_ate_correlated", ate(precision->predicted_centre_ate_correlated)},
+          {"seconds", precision->seconds}};
 }
 
 nlohmann::json ateToJson(const AteResult& ate) {

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "core/check.h"
+#include "core/clock.h"
 #include "core/median.h"
 #include "factors/centre_precision.h"
 #include "graph/variable_traits.h"
@@ -107,33 +108,42 @@ struct GroupSystem {
   std::map<int, Eigen::MatrixXd> coupling;  // pose -> dimension x 6
 };
 
-// Rows of one factor's Jacobian, already weighted, into the group's and the poses' blocks.
+// Rows of one factor's Jacobian, already weighted, into the group's and the poses' blocks: only
+// the blocks of the keys it touches, so that a long curve's factors cost no more than a short
+// one's.
 void accumulate(const Factor& factor, const std::vector<Eigen::MatrixXd>& rows, int pose,
                 GroupSystem* group, Eigen::MatrixXd* reduced) {
-  Eigen::MatrixXd structure_rows = Eigen::MatrixXd::Zero(rows[0].rows(), group->dimension);
-  Eigen::MatrixXd pose_rows;
-  for (std::size_t i = 0; i < factor.keys().size(); ++i) {
-    const Key key = factor.keys()[i];
-    if (!isStructure(key)) {
-      pose_rows = rows[i];
-      continue;
-    }
-    structure_rows.middleCols(group->offset.at(key), rows[i].cols()) += rows[i];
+  const std::vector<Key>& keys = factor.keys();
+  const Eigen::MatrixXd* pose_rows = nullptr;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (!isStructure(keys[i])) pose_rows = &rows[i];
   }
-  group->structure.noalias() += structure_rows.transpose() * structure_rows;
-  if (pose < 0) return;
-  Eigen::MatrixXd& coupling = group->coupling[pose];
-  if (coupling.size() == 0) coupling = Eigen::MatrixXd::Zero(group->dimension, 6);
-  coupling.noalias() += structure_rows.transpose() * pose_rows;
-  reduced->block<6, 6>(6 * pose, 6 * pose).noalias() += pose_rows.transpose() * pose_rows;
+  if (pose >= 0 && group->coupling[pose].size() == 0) {
+    group->coupling[pose] = Eigen::MatrixXd::Zero(group->dimension, 6);
+  }
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (!isStructure(keys[i])) continue;
+    const int row = group->offset.at(keys[i]);
+    for (std::size_t j = 0; j < keys.size(); ++j) {
+      if (!isStructure(keys[j])) continue;
+      group->structure.block(row, group->offset.at(keys[j]), rows[i].cols(), rows[j].cols())
+          .noalias() += rows[i].transpose() * rows[j];
+    }
+    if (pose >= 0) {
+      group->coupling[pose].middleRows(row, rows[i].cols()).noalias() +=
+          rows[i].transpose() * *pose_rows;
+    }
+  }
+  if (pose >= 0) {
+    reduced->block<6, 6>(6 * pose, 6 * pose).noalias() += pose_rows->transpose() * *pose_rows;
+  }
 }
 
-// The Jacobian rows of one factor at `values`, weighted by the robust kernel; an edge factor's
-// live rows only, AR(1)-whitened along the samples when `correlation` != 0; a structure term's
-// against the edges' sigma in the objective (`edge_model_sigma`), as the BA weighs them.
-std::vector<Eigen::MatrixXd> weightedRows(const Factor& factor, const Values& values,
+// The Jacobian rows of one factor linearised at `lin`, weighted by the robust kernel; an edge
+// factor's live rows only, AR(1)-whitened along the samples when `correlation` != 0; a structure
+// term's against the edges' sigma in the objective (`edge_model_sigma`), as the BA weighs them.
+std::vector<Eigen::MatrixXd> weightedRows(const Factor& factor, const Linearization& lin,
                                           double edge_model_sigma, double correlation) {
-  Linearization lin = factor.linearize(values);
   const NoiseModel& noise = factor.noiseModel();
   double rho[3];
   noise.kernel.evaluate(lin.error.squaredNorm() / (noise.sigma * noise.sigma), rho);
@@ -141,38 +151,81 @@ std::vector<Eigen::MatrixXd> weightedRows(const Factor& factor, const Values& va
   const double weight =
       std::sqrt(std::max(rho[1], 0.0)) * (edge != nullptr ? 1.0 : edge_model_sigma / noise.sigma);
   const int n = static_cast<int>(lin.error.size());
-  Eigen::VectorXd live = Eigen::VectorXd::Ones(n);
+  std::vector<bool> live(n, true);
   if (edge != nullptr) {
-    for (int k = 0; k < n; ++k) live(k) = isLive(lin.error(k), edge->cappedResidual()) ? 1.0 : 0.0;
+    for (int k = 0; k < n; ++k) live[k] = isLive(lin.error(k), edge->cappedResidual());
   }
   const double innovation = 1.0 / std::sqrt(1.0 - correlation * correlation);
-  for (Eigen::MatrixXd& j : lin.jacobians) {
+  std::vector<Eigen::MatrixXd> rows;
+  for (const Eigen::MatrixXd& j : lin.jacobians) {
     Eigen::MatrixXd whitened = j;
     for (int k = 0; k < n; ++k) {
-      if (live(k) == 0.0) {
+      if (!live[k]) {
         whitened.row(k).setZero();
-      } else if (edge != nullptr && correlation != 0.0 && k > 0 && live(k - 1) != 0.0) {
+      } else if (edge != nullptr && correlation != 0.0 && k > 0 && live[k - 1]) {
         whitened.row(k) = (j.row(k) - correlation * j.row(k - 1)) * innovation;
       }
     }
-    j = whitened * weight;
+    rows.push_back(whitened * weight);
   }
-  return std::move(lin.jacobians);
+  return rows;
 }
 
-// The pose information of one group's factors, the group eliminated, added to `reduced`.
-void addGroup(const FactorGraph& graph, const std::vector<int>& factors, const Values& values,
-              int keyframes, double edge_model_sigma, double correlation,
-              Eigen::MatrixXd* reduced) {
-  GroupSystem group;
-  for (int f : factors) {
-    for (Key key : graph[f]->keys()) {
-      if (!isStructure(key) || group.offset.count(key) > 0) continue;
-      group.offset[key] = group.dimension;
-      group.dimension += tangentDim(values.type(key));
+// Subtracts sum over pose pairs of coupling_b^T X_a from the poses' information, X_a the
+// structure block's (pseudo-)inverse applied to coupling_a.
+template <class Solve>
+void subtractCouplings(const GroupSystem& group, const Solve& solve, Eigen::MatrixXd* reduced) {
+  for (const auto& [a, coupling_a] : group.coupling) {
+    const Eigen::MatrixXd solved = solve(coupling_a);
+    for (const auto& [b, coupling_b] : group.coupling) {
+      reduced->block<6, 6>(6 * b, 6 * a).noalias() -= coupling_b.transpose() * solved;
     }
   }
-  group.structure = Eigen::MatrixXd::Zero(group.dimension, group.dimension);
+}
+
+// Subtracts the group's part from the poses' information, its structure eliminated: by an LDLT
+// where the structure block is well conditioned (a long curve's block has hundreds of rows, where
+// an eigen-decomposition would cost most of the figure's time), else through the pseudo-inverse,
+// so that a direction no observation fixes stays out.
+void eliminate(const GroupSystem& group, Eigen::MatrixXd* reduced) {
+  constexpr double kRelativeFloor = 1e-10;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(group.structure);
+  const Eigen::VectorXd& pivots = ldlt.vectorD();
+  if (ldlt.info() == Eigen::Success && pivots.minCoeff() > kRelativeFloor * pivots.maxCoeff()) {
+    subtractCouplings(
+        group, [&ldlt](const Eigen::MatrixXd& c) -> Eigen::MatrixXd { return ldlt.solve(c); },
+        reduced);
+    return;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(group.structure);
+  const Eigen::VectorXd& lambda = eigen.eigenvalues();
+  const double floor = kRelativeFloor * std::max(lambda.maxCoeff(), 0.0);
+  const Eigen::VectorXd inverse =
+      lambda.unaryExpr([floor](double l) { return l > floor ? 1.0 / l : 0.0; });
+  const Eigen::MatrixXd& v = eigen.eigenvectors();
+  subtractCouplings(
+      group,
+      [&](const Eigen::MatrixXd& c) -> Eigen::MatrixXd {
+        return v * (inverse.asDiagonal() * (v.transpose() * c));
+      },
+      reduced);
+}
+
+// The pose information of one group's factors, the group eliminated, added to `reduced[i]` for
+// each of `correlations`; each factor is linearised once for all of them.
+void addGroup(const FactorGraph& graph, const std::vector<int>& factors, const Values& values,
+              int keyframes, double edge_model_sigma, const std::vector<double>& correlations,
+              std::vector<Eigen::MatrixXd>* reduced) {
+  GroupSystem prototype;
+  for (int f : factors) {
+    for (Key key : graph[f]->keys()) {
+      if (!isStructure(key) || prototype.offset.count(key) > 0) continue;
+      prototype.offset[key] = prototype.dimension;
+      prototype.dimension += tangentDim(values.type(key));
+    }
+  }
+  prototype.structure = Eigen::MatrixXd::Zero(prototype.dimension, prototype.dimension);
+  std::vector<GroupSystem> groups(correlations.size(), prototype);
   for (int f : factors) {
     const Factor& factor = *graph[f];
     int pose = -1;
@@ -180,22 +233,13 @@ void addGroup(const FactorGraph& graph, const std::vector<int>& factors, const V
       if (!isStructure(key)) pose = static_cast<int>(key.index());
     }
     if (pose >= keyframes) continue;
-    accumulate(factor, weightedRows(factor, values, edge_model_sigma, correlation), pose, &group,
-               reduced);
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(group.structure);
-  const Eigen::VectorXd& lambda = eigen.eigenvalues();
-  const double floor = 1e-10 * std::max(lambda.maxCoeff(), 0.0);
-  const Eigen::VectorXd inverse =
-      lambda.unaryExpr([floor](double l) { return l > floor ? 1.0 / l : 0.0; });
-  const Eigen::MatrixXd& v = eigen.eigenvectors();
-  for (const auto& [a, coupling_a] : group.coupling) {
-    const Eigen::MatrixXd projected = inverse.asDiagonal() * (v.transpose() * coupling_a);
-    for (const auto& [b, coupling_b] : group.coupling) {
-      reduced->block<6, 6>(6 * b, 6 * a).noalias() -=
-          (v.transpose() * coupling_b).transpose() * projected;
+    const Linearization lin = factor.linearize(values);
+    for (std::size_t c = 0; c < correlations.size(); ++c) {
+      accumulate(factor, weightedRows(factor, lin, edge_model_sigma, correlations[c]), pose,
+                 &groups[c], &(*reduced)[c]);
     }
   }
+  for (std::size_t c = 0; c < correlations.size(); ++c) eliminate(groups[c], &(*reduced)[c]);
 }
 
 // The counted factors of each structure group, by factor index.
@@ -238,21 +282,39 @@ double edgeModelSigma(const FactorGraph& graph) {
 
 }  // namespace
 
+namespace {
+
+// The curves' information on the poses for each of `correlations` (curvePoseInformation).
+std::vector<Eigen::MatrixXd> poseInformations(const CurveBundleAdjustmentProblem& problem,
+                                              int keyframes, double pixel_sigma,
+                                              const std::vector<double>& correlations) {
+  CURVESFM_CHECK(keyframes >= 0 && pixel_sigma > 0.0)
+      << keyframes << " keyframes, pixel sigma " << pixel_sigma;
+  for (double correlation : correlations) {
+    CURVESFM_CHECK(std::abs(correlation) < 1.0) << "correlation " << correlation;
+  }
+  const double model_sigma = edgeModelSigma(problem.graph);
+  std::vector<Eigen::MatrixXd> reduced(correlations.size(),
+                                       Eigen::MatrixXd::Zero(6 * keyframes, 6 * keyframes));
+  for (const std::vector<int>& factors : groupFactors(problem.graph)) {
+    addGroup(problem.graph, factors, problem.values, keyframes, model_sigma, correlations,
+             &reduced);
+  }
+  for (Eigen::MatrixXd& information : reduced) information /= pixel_sigma * pixel_sigma;
+  return reduced;
+}
+
+}  // namespace
+
 Eigen::MatrixXd curvePoseInformation(const CurveBundleAdjustmentProblem& problem, int keyframes,
                                      double pixel_sigma, double correlation) {
-  CURVESFM_CHECK(keyframes >= 0 && pixel_sigma > 0.0 && std::abs(correlation) < 1.0)
-      << keyframes << " keyframes, pixel sigma " << pixel_sigma << ", correlation " << correlation;
-  const double model_sigma = edgeModelSigma(problem.graph);
-  Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(6 * keyframes, 6 * keyframes);
-  for (const std::vector<int>& factors : groupFactors(problem.graph)) {
-    addGroup(problem.graph, factors, problem.values, keyframes, model_sigma, correlation, &reduced);
-  }
-  return reduced / (pixel_sigma * pixel_sigma);
+  return poseInformations(problem, keyframes, pixel_sigma, {correlation}).front();
 }
 
 CurveCentrePrecision curveCentrePrecision(const CurveBundleAdjustmentProblem& problem,
                                           int keyframes) {
   CURVESFM_CHECK(keyframes >= 0) << keyframes << " keyframes";
+  const Clock::time_point start = Clock::now();
   CurveCentrePrecision out;
   const EdgeResiduals residuals = collectResiduals(problem.graph, problem.values);
   out.observations = residuals.observations;
@@ -262,10 +324,11 @@ CurveCentrePrecision curveCentrePrecision(const CurveBundleAdjustmentProblem& pr
   if (!(out.pixel_sigma > 0.0)) return out;
   out.sample_correlation = lagOneCorrelation(problem.graph, problem.values, out.pixel_sigma);
   const std::vector<Pose3> poses = extractPoses(problem.values, keyframes);
-  out.predicted_centre_ate = predictedCentreAteFromInformation(
-      curvePoseInformation(problem, keyframes, out.pixel_sigma, 0.0), poses);
-  out.predicted_centre_ate_correlated = predictedCentreAteFromInformation(
-      curvePoseInformation(problem, keyframes, out.pixel_sigma, out.sample_correlation), poses);
+  const std::vector<Eigen::MatrixXd> information =
+      poseInformations(problem, keyframes, out.pixel_sigma, {0.0, out.sample_correlation});
+  out.predicted_centre_ate = predictedCentreAteFromInformation(information[0], poses);
+  out.predicted_centre_ate_correlated = predictedCentreAteFromInformation(information[1], poses);
+  out.seconds = secondsSince(start);
   return out;
 }
 

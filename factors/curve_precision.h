@@ -33,6 +33,7 @@ struct CurveCentrePrecision {
   /// where the curves leave more than the similarity free; NaN before it was computed.
   double predicted_centre_ate = std::nan("");
   double predicted_centre_ate_correlated = std::nan("");
+  double seconds = 0.0;  ///< Wall time of computing it.
 };
 
 /// The curves' information on the poses (6 rows per keyframe, Pose3's tangent) that

@@ -121,6 +121,7 @@ TEST_F(RunCommandTest, ShortPlanarRunWritesEveryOutput) {
     EXPECT_GT(precision["predicted_centre_ate_correlated"].get<double>(),
               precision["predicted_centre_ate"].get<double>());
   }
+  EXPECT_GE(precision["seconds"].get<double>(), 0.0);
   EXPECT_THAT(result.output, HasSubstr("curves' precision: their edge noise"));
   EXPECT_TRUE(report["frames"][5]["rejected_segments"].contains("edge_distance"));
   // Keyframe 5's local BA refined the curves its window observes.

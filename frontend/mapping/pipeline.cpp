@@ -440,6 +440,7 @@ struct Pipeline::Impl {
   std::vector<ImplausibleCurve> implausible;
   SceneExtent extent;
   int global_bas = 0;
+  double kernel_width_of_last_global_ba = 0.0;  // The edge kernel it weighed with.
 };
 
 // Once the gate knows the scene scale (see PipelineOptions::scene_scale): the keyframes before
@@ -742,8 +743,7 @@ std::optional<CurveCentrePrecision> Pipeline::Impl::curvePrecisionInPoseUnits() 
   const CurveBundleAdjustmentInput input = bundleInput(CurveSelection::kPromoted, &ids);
   if (input.observations.empty()) return std::nullopt;
   CurveBundleAdjustmentOptions ba = options.ba;
-  if (options.last_global_ba_kernel_width > 0.0)
-    ba.kernel_width = options.last_global_ba_kernel_width;
+  ba.kernel_width = kernel_width_of_last_global_ba;
   CurveCentrePrecision precision = curveCentrePrecision(buildCurveBundleAdjustment(input, ba), n);
   precision.predicted_centre_ate *= unit();
   precision.predicted_centre_ate_correlated *= unit();
@@ -1171,6 +1171,7 @@ ScheduleReport Pipeline::Impl::globalBundleAdjust(bool interim, CurveSampleCount
   ScheduleReport report =
       bundleAdjust(CurveSelection::kPromoted, scheduler, ba, /*refine_poses=*/true, samples);
   ++global_bas;
+  kernel_width_of_last_global_ba = ba.kernel_width;
   return report;
 }
 

@@ -153,9 +153,9 @@ struct PipelineOptions {
   double last_global_ba_kernel_width = 1.0;
   /// After the last global BA, how precisely the curves fix the camera centres
   /// (factors/curve_precision.h: the ATE the edge noise alone would leave), for runs of at most
-  /// this many keyframes: it linearises every edge factor once and eliminates each curve, 3-5 % of
-  /// a run (templeRing 1 s, fountain-P11's 39,000 observations 5 s of 187 s), and inverts
-  /// 6 x keyframes rows. >= 0; 0: never.
+  /// this many keyframes: it linearises every edge factor once and eliminates each curve, a few
+  /// per cent of a run (templeRing 1 s, fountain-P11's 39,000 observations 5 s of 187 s), and
+  /// inverts 6 x keyframes rows. >= 0; 0: never.
   int curve_precision_max_keyframes = 200;
   /// Re-association leaves a keyframe's edges to the curves already observed there: a segment
   /// whose projection lies mostly (over half its samples) within explained_radius_px of the

@@ -30,9 +30,11 @@ CurveBundleAdjustmentOptions unitFreeOptions() {
 
 bool isPose(Key key) { return categoryOf(key) == VariableCategory::kPose; }
 
-// The same information by brute force: every variable in one dense system, the structure
-// eliminated by one pseudo-inverse; every row at its plain weight.
-Eigen::MatrixXd denseInformation(const CurveBundleAdjustmentProblem& problem, int keyframes) {
+// The same information by brute force: every variable in one dense system, each edge
+// observation's samples weighed by the inverse of their AR(1) covariance rho^|i - j| (every
+// sample live), the structure eliminated by one pseudo-inverse.
+Eigen::MatrixXd denseInformation(const CurveBundleAdjustmentProblem& problem, int keyframes,
+                                 double correlation = 0.0) {
   std::map<Key, int> offset;
   int dimension = 6 * keyframes;
   for (int j = 0; j < keyframes; ++j) offset[poseKey(j)] = 6 * j;
@@ -58,7 +60,14 @@ Eigen::MatrixXd denseInformation(const CurveBundleAdjustmentProblem& problem, in
       rows.middleCols(offset.at(factor->keys()[i]), lin.jacobians[i].cols()) = lin.jacobians[i];
     }
     const double sigma = factor->noiseModel().sigma;
-    h += rows.transpose() * rows / (sigma * sigma);
+    const int n = static_cast<int>(lin.error.size());
+    Eigen::MatrixXd covariance = Eigen::MatrixXd::Identity(n, n);
+    if (dynamic_cast<const CurveReprojectionFactor*>(factor) != nullptr) {
+      for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) covariance(i, j) = std::pow(correlation, std::abs(i - j));
+      }
+    }
+    h += rows.transpose() * covariance.inverse() * rows / (sigma * sigma);
   }
   const int poses = 6 * keyframes;
   const int structure = dimension - poses;
@@ -82,9 +91,11 @@ TEST(CurvePrecision, EliminatesEachCurveAsTheDenseSystemDoes) {
   const CurveBundleAdjustmentProblem problem = buildCurveBundleAdjustment(input, options);
   const CurveSampleCounts samples = countCurveSamples(problem.graph, problem.values);
   ASSERT_EQ(samples.capped(), 0);
-  const Eigen::MatrixXd ours = curvePoseInformation(problem, 4, 1.0, 0.0);
-  const Eigen::MatrixXd dense = denseInformation(problem, 4);
-  EXPECT_LT((ours - dense).norm(), 1e-6 * dense.norm());
+  for (const double correlation : {0.0, 0.6}) {
+    const Eigen::MatrixXd ours = curvePoseInformation(problem, 4, 1.0, correlation);
+    const Eigen::MatrixXd dense = denseInformation(problem, 4, correlation);
+    EXPECT_LT((ours - dense).norm(), 1e-6 * dense.norm()) << "correlation " << correlation;
+  }
 }
 
 TEST(CurvePrecision, FollowsTheSceneUnitAndTheNoise) {

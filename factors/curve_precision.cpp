@@ -34,10 +34,13 @@ bool counts(const Factor& factor) {
 
 bool isStructure(Key key) { return categoryOf(key) != VariableCategory::kPose; }
 
-// Live samples' residuals of every edge factor: a capped sample sits at the field's reach.
+// Every edge factor's residuals, evaluated once for the noise and the correlation; a capped
+// sample sits at the field's reach.
 struct EdgeResiduals {
-  std::vector<double> absolute;  // |r| of every live sample
-  int observations = 0;          // edge factors with a live sample
+  std::vector<Eigen::VectorXd> errors;  // per edge factor
+  std::vector<double> caps;             // its field's reach
+  std::vector<double> absolute;         // |r| of every live sample
+  int observations = 0;                 // edge factors with a live sample
 };
 
 bool isLive(double residual, double cap) { return std::abs(residual) < cap; }
@@ -47,11 +50,12 @@ EdgeResiduals collectResiduals(const FactorGraph& graph, const Values& values) {
   for (const auto& factor : graph) {
     const CurveReprojectionFactor* edge = asEdgeFactor(*factor);
     if (edge == nullptr) continue;
-    const Eigen::VectorXd e = edge->unwhitenedError(values);
-    const double cap = edge->cappedResidual();
+    out.errors.push_back(edge->unwhitenedError(values));
+    out.caps.push_back(edge->cappedResidual());
+    const Eigen::VectorXd& e = out.errors.back();
     bool any = false;
     for (int k = 0; k < e.size(); ++k) {
-      if (!isLive(e(k), cap)) continue;
+      if (!isLive(e(k), out.caps.back())) continue;
       out.absolute.push_back(std::abs(e(k)));
       any = true;
     }
@@ -61,13 +65,11 @@ EdgeResiduals collectResiduals(const FactorGraph& graph, const Values& values) {
 }
 
 // Pooled lag-1 correlation of consecutive live samples within 3 sigmas.
-double lagOneCorrelation(const FactorGraph& graph, const Values& values, double sigma) {
+double lagOneCorrelation(const EdgeResiduals& residuals, double sigma) {
   double products = 0.0, leads = 0.0, lags = 0.0;
-  for (const auto& factor : graph) {
-    const CurveReprojectionFactor* edge = asEdgeFactor(*factor);
-    if (edge == nullptr) continue;
-    const Eigen::VectorXd e = edge->unwhitenedError(values);
-    const double cap = std::min(edge->cappedResidual(), 3.0 * sigma);
+  for (std::size_t f = 0; f < residuals.errors.size(); ++f) {
+    const Eigen::VectorXd& e = residuals.errors[f];
+    const double cap = std::min(residuals.caps[f], 3.0 * sigma);
     for (int k = 1; k < e.size(); ++k) {
       if (!isLive(e(k - 1), cap) || !isLive(e(k), cap)) continue;
       products += e(k - 1) * e(k);
@@ -322,7 +324,7 @@ CurveCentrePrecision curveCentrePrecision(const CurveBundleAdjustmentProblem& pr
   if (out.samples == 0) return out;
   out.pixel_sigma = kMadToSigma * upperMedian(residuals.absolute);
   if (!(out.pixel_sigma > 0.0)) return out;
-  out.sample_correlation = lagOneCorrelation(problem.graph, problem.values, out.pixel_sigma);
+  out.sample_correlation = lagOneCorrelation(residuals, out.pixel_sigma);
   const std::vector<Pose3> poses = extractPoses(problem.values, keyframes);
   const std::vector<Eigen::MatrixXd> information =
       poseInformations(problem, keyframes, out.pixel_sigma, {0.0, out.sample_correlation});
